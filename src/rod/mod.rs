@@ -1,0 +1,213 @@
+//! The rod of He et al. (2024), Section 3: a segment `[0, π̃]` of homogeneous
+//! medium (scattering `κs`, extinction `κe`, absorption `κa = κe − κs`) where
+//! particles travel only along the axis, `ω ∈ {+1, −1}`, and scatter
+//! isotropically between the two directions. Intensity `I0` enters at `x = 0`
+//! going right; nothing enters at `x = π̃`. The shape parameter is the length
+//! `π̃`; the sensitivity is `s(x, ω) = ∂I/∂π̃` at fixed `x`.
+//!
+//! A rod needs a float and a sign, so positions are `f64` and directions are
+//! [`Direction`]. The estimators live in one module each, the exact solution in
+//! [`exact`], the shared random walk in [`walk`]. Book: chapter "The rod".
+use crate::error::{Error, check};
+use crate::estimator::Estimator;
+
+pub mod exact;
+pub mod expectation;
+pub mod intensity;
+pub mod rendering;
+pub mod transport;
+pub mod walk;
+
+/// A direction of travel along the rod.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Direction {
+    /// `ω = +1`, towards increasing `x`.
+    Right,
+    /// `ω = −1`, towards decreasing `x`.
+    Left,
+}
+
+impl Direction {
+    /// `ω` as a number, `+1` or `−1`.
+    #[inline]
+    pub fn sign(self) -> f64 {
+        match self {
+            Direction::Right => 1.0,
+            Direction::Left => -1.0,
+        }
+    }
+
+    /// The opposite direction: a backward path from a probe looking along `ω`
+    /// travels along `−ω`.
+    #[inline]
+    pub fn reverse(self) -> Direction {
+        match self {
+            Direction::Right => Direction::Left,
+            Direction::Left => Direction::Right,
+        }
+    }
+
+    /// The rod end that a particle travelling this way reaches.
+    #[inline]
+    pub fn end(self) -> Side {
+        match self {
+            Direction::Right => Side::End,
+            Direction::Left => Side::Start,
+        }
+    }
+
+    /// Parses `ω` from a number: `+1` or `−1`, anything else is an error.
+    pub fn from_sign(omega: f64) -> Result<Direction, Error> {
+        if omega == 1.0 {
+            Ok(Direction::Right)
+        } else if omega == -1.0 {
+            Ok(Direction::Left)
+        } else {
+            Err(Error::InvalidParameter {
+                name: "omega",
+                value: omega,
+                expected: "+1 or -1",
+            })
+        }
+    }
+}
+
+/// An end of the rod.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Side {
+    /// `x = 0`, the fixed end where `I0` enters.
+    Start,
+    /// `x = π̃`, the moving end.
+    End,
+}
+
+/// The rod: its coefficients, its length and the intensity entering at `x = 0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rod {
+    /// Scattering coefficient `κs ≥ 0`.
+    pub ks: f64,
+    /// Extinction coefficient `κe ≥ κs`.
+    pub ke: f64,
+    /// Length `π̃ > 0`, the shape parameter.
+    pub length: f64,
+    /// Intensity `I0` entering at `x = 0` going right.
+    pub incoming: f64,
+}
+
+impl Rod {
+    /// A rod with `I0 = 1`; errors name any value out of its domain.
+    pub fn new(ks: f64, ke: f64, length: f64) -> Result<Rod, Error> {
+        let ks = check("ks", ks, ks >= 0.0, "a finite number >= 0")?;
+        let ke = check("ke", ke, ke >= ks, "a finite number >= ks")?;
+        let length = check("length", length, length > 0.0, "a finite number > 0")?;
+        Ok(Rod {
+            ks,
+            ke,
+            length,
+            incoming: 1.0,
+        })
+    }
+
+    /// The same rod with entering intensity `i0` (finite, ≥ 0).
+    pub fn with_incoming(self, i0: f64) -> Result<Rod, Error> {
+        let incoming = check("incoming", i0, i0 >= 0.0, "a finite number >= 0")?;
+        Ok(Rod { incoming, ..self })
+    }
+
+    /// Absorption coefficient `κa = κe − κs`.
+    #[inline]
+    pub fn ka(&self) -> f64 {
+        self.ke - self.ks
+    }
+
+    /// Single-scattering albedo `λ = κs/κe` (0 for an empty rod).
+    pub fn albedo(&self) -> f64 {
+        if self.ke > 0.0 {
+            self.ks / self.ke
+        } else {
+            0.0
+        }
+    }
+
+    /// The intensity entering the rod at `side`: what a backward path that
+    /// leaves through `side` collects (`I0` at the start, 0 at the end).
+    #[inline]
+    pub fn incoming_at(&self, side: Side) -> f64 {
+        match side {
+            Side::Start => self.incoming,
+            Side::End => 0.0,
+        }
+    }
+
+    /// Distance from `x` to the end reached travelling along `dir` (Eq. 27).
+    #[inline]
+    pub fn distance_to_boundary(&self, x: f64, dir: Direction) -> f64 {
+        match dir {
+            Direction::Right => self.length - x,
+            Direction::Left => x,
+        }
+    }
+}
+
+/// Where the intensity is observed: a position on the rod and a direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Probe {
+    /// Position `0 ≤ x ≤ π̃`.
+    pub x: f64,
+    /// Direction `ω` of the observed intensity.
+    pub omega: Direction,
+}
+
+impl Probe {
+    /// A probe on `rod`; errors if `x` is outside `[0, π̃]` or not finite.
+    pub fn new(rod: &Rod, x: f64, omega: Direction) -> Result<Probe, Error> {
+        let x = check("x", x, (0.0..=rod.length).contains(&x), "0 <= x <= length")?;
+        Ok(Probe { x, omega })
+    }
+}
+
+/// The four Monte Carlo methods on the rod.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Backward path tracing of `I` (Algorithm 3).
+    Intensity,
+    /// Expectation differentiation: `I` and `s` from the same paths (Algorithm 4).
+    Expectation,
+    /// Differentiable rendering with double randomization (Algorithm 5).
+    Rendering,
+    /// The coupled transport models `{I, s, ∂xI}` (Eqs. 41–43).
+    Transport,
+}
+
+impl Method {
+    /// All four, in the order the comparison tables print them.
+    pub const ALL: [Method; 4] = [
+        Method::Intensity,
+        Method::Expectation,
+        Method::Rendering,
+        Method::Transport,
+    ];
+
+    /// The method's name, as the CLI spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Intensity => "intensity",
+            Method::Expectation => "expectation",
+            Method::Rendering => "rendering",
+            Method::Transport => "transport",
+        }
+    }
+
+    /// The estimator of this method for `probe` on `rod`.
+    pub fn estimator(self, rod: Rod, probe: Probe) -> Box<dyn Estimator> {
+        match self {
+            Method::Intensity => Box::new(intensity::IntensityEstimator { rod, probe }),
+            Method::Expectation => Box::new(expectation::ExpectationEstimator { rod, probe }),
+            Method::Rendering => Box::new(rendering::RenderingEstimator { rod, probe }),
+            Method::Transport => Box::new(transport::TransportEstimator { rod, probe }),
+        }
+    }
+}
+
+/// The name of the rod's shape parameter in estimator outputs.
+pub const PARAMETER: &str = "length";
