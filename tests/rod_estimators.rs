@@ -1,0 +1,118 @@
+//! Every rod estimator against the exact Bellman–Wing solution: the paper's
+//! thin and thick rods, both directions, positions across the rod including
+//! both ends, within 4 standard errors at fixed seeds; the limit cases
+//! κa = 0 and κs = 0; error scaling as 1/√N; bit-identical results for 1 and 2
+//! threads.
+mod common;
+use common::*;
+use geosens::rod::{Direction, Method, Probe, Rod};
+use geosens::{Quantity, RunConfig, run};
+
+const XS: [f64; 7] = [0.0, 0.25, 0.5, 1.0, 1.5, 1.9, 2.0];
+
+fn sweep(rod: Rod, paths: u64, seed: u64) {
+    for method in Method::ALL {
+        for (i, &x) in XS.iter().enumerate() {
+            for omega in [Direction::Right, Direction::Left] {
+                assert_within(method, rod, x, omega, paths, seed + i as u64, 4.0);
+            }
+        }
+    }
+}
+
+#[test]
+fn thin_rod_all_methods_match_exact() {
+    sweep(thin(), 400_000, 11);
+}
+
+#[test]
+fn thick_rod_all_methods_match_exact() {
+    sweep(thick(), 400_000, 23);
+}
+
+#[test]
+fn no_absorption_and_no_scattering() {
+    let conservative = Rod::new(1.3, 1.3, 2.0).unwrap();
+    let absorber = Rod::new(0.0, 1.3, 2.0).unwrap();
+    let empty = Rod::new(0.0, 0.0, 2.0).unwrap();
+    for (rod, seed) in [(conservative, 5), (absorber, 6), (empty, 7)] {
+        for method in Method::ALL {
+            for x in [0.0, 0.7, 2.0] {
+                for omega in [Direction::Right, Direction::Left] {
+                    assert_within(method, rod, x, omega, 200_000, seed, 4.0);
+                }
+            }
+        }
+    }
+    // Without scattering every weight is deterministic: the estimates are exact.
+    for method in Method::ALL {
+        let r = estimate(method, absorber, 0.7, Direction::Right, 1000, 1);
+        let i = r.get(&Quantity::Intensity).unwrap();
+        assert!((i.mean - (-1.3f64 * 0.7).exp()).abs() < 1e-15 && i.stderr < 1e-15);
+    }
+}
+
+#[test]
+fn sensitivity_moves_the_right_way() {
+    // A longer rod scatters more back towards x: s(x, −1) > 0 (the sign the
+    // paper's Eq. 43 gets wrong); the estimators must see it at many σ.
+    for method in [Method::Expectation, Method::Rendering, Method::Transport] {
+        let r = estimate(method, thick(), 1.0, Direction::Left, 200_000, 3);
+        let s = r.get(&Quantity::sensitivity("length")).unwrap();
+        assert!(s.mean > 10.0 * s.stderr, "{}: {s:?}", method.name());
+    }
+}
+
+#[test]
+fn error_scales_as_inverse_sqrt_n() {
+    // The standard error shrinks by 4 for 16 times more paths, and the actual
+    // error over 16 independent runs does too (RMS ratio, loose bounds).
+    let rod = thick();
+    let (x, omega) = (1.0, Direction::Left);
+    for method in Method::ALL {
+        let rms = |paths: u64| {
+            let mut sum = 0.0;
+            let mut se = 0.0;
+            for seed in 0..16 {
+                let r = estimate(method, rod, x, omega, paths, 1000 + seed);
+                let (q, e) = r.estimates.last().unwrap().clone();
+                let d = e.mean - exact_value(&rod, x, omega, &q);
+                sum += d * d;
+                se += e.stderr;
+            }
+            ((sum / 16.0).sqrt(), se / 16.0)
+        };
+        let (rms_small, se_small) = rms(20_000);
+        let (rms_large, se_large) = rms(320_000);
+        let se_ratio = se_small / se_large;
+        assert!(
+            (3.7..4.3).contains(&se_ratio),
+            "{}: stderr ratio {se_ratio}",
+            method.name()
+        );
+        let err_ratio = rms_small / rms_large;
+        assert!(
+            (2.0..8.0).contains(&err_ratio),
+            "{}: RMS error ratio {err_ratio}",
+            method.name()
+        );
+    }
+}
+
+#[test]
+fn bit_identical_for_one_and_two_threads() {
+    for method in Method::ALL {
+        let rod = thick();
+        let probe = Probe::new(&rod, 1.0, Direction::Left).unwrap();
+        let est = method.estimator(rod, probe);
+        // 10 chunks and a partial one.
+        let cfg = RunConfig::new(10 * 4096 + 123, 99).unwrap();
+        let one = run(est.as_ref(), &cfg.threads(1)).unwrap();
+        let two = run(est.as_ref(), &cfg.threads(2)).unwrap();
+        let three = run(est.as_ref(), &cfg.threads(3)).unwrap();
+        assert_eq!(one.estimates, two.estimates, "{}", method.name());
+        assert_eq!(one.estimates, three.estimates, "{}", method.name());
+        let other_seed = run(est.as_ref(), &RunConfig::new(cfg.paths, 100).unwrap()).unwrap();
+        assert_ne!(one.estimates, other_seed.estimates);
+    }
+}
