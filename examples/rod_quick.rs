@@ -1,28 +1,54 @@
+//! Quick start: every method on the paper's thin and thick rods, at a few
+//! probes, against the exact solution.
+//!
+//! ```text
+//! cargo run --release --example rod_quick
+//! ```
 use geosens::rod::{Direction, Method, Probe, Rod, exact};
-use geosens::{RunConfig, run};
-fn main() {
-    for (ks, ke) in [(0.07, 0.1), (2.1, 3.0)] {
-        let rod = Rod::new(ks, ke, 2.0).unwrap();
+use geosens::{Error, Quantity, RunConfig, run};
+
+fn main() -> Result<(), Error> {
+    let cfg = RunConfig::new(1_000_000, 1)?;
+    for (name, ks, ke) in [("thin", 0.07, 0.1), ("thick", 2.1, 3.0)] {
+        let rod = Rod::new(ks, ke, 2.0)?;
+        println!(
+            "{name} rod: κs = {ks}, κe = {ke}, length 2, {} paths",
+            cfg.paths
+        );
         for x in [0.0, 1.0, 1.9, 2.0] {
-            for om in [Direction::Right, Direction::Left] {
-                let p = Probe::new(&rod, x, om).unwrap();
-                let ex = exact::solve(&rod, x, om);
-                print!(
-                    "ks={ks} x={x} {om:?} exact I={:.5} s={:.5} dx={:.5} |",
-                    ex.intensity, ex.sensitivity, ex.gradient_x
+            for omega in [Direction::Right, Direction::Left] {
+                let probe = Probe::new(&rod, x, omega)?;
+                let ex = exact::solve(&rod, x, omega);
+                println!(
+                    "  x = {x}, ω = {:+}: exact I = {:.5}, s = {:.5}, ∂xI = {:.5}",
+                    omega.sign(),
+                    ex.intensity,
+                    ex.sensitivity,
+                    ex.gradient_x
                 );
-                for m in Method::ALL {
-                    let r = run(
-                        m.estimator(rod, p).as_ref(),
-                        &RunConfig::new(1_000_000, 1).unwrap(),
-                    )
-                    .unwrap();
-                    for (q, e) in &r.estimates {
-                        print!(" {}:{q}={:.5}±{:.5}", m.name(), e.mean, e.stderr);
-                    }
+                for method in Method::ALL {
+                    let r = run(method.estimator(rod, probe).as_ref(), &cfg)?;
+                    let cells: Vec<String> = r
+                        .estimates
+                        .iter()
+                        .map(|(q, e)| {
+                            let reference = match q {
+                                Quantity::Intensity => ex.intensity,
+                                Quantity::Sensitivity(_) => ex.sensitivity,
+                                Quantity::Gradient(_) => ex.gradient_x,
+                            };
+                            format!(
+                                "{q} = {:.5} ± {:.5} (z {:.1})",
+                                e.mean,
+                                e.stderr,
+                                e.z_score(reference)
+                            )
+                        })
+                        .collect();
+                    println!("    {:<12} {}", method.name(), cells.join(", "));
                 }
-                println!();
             }
         }
     }
+    Ok(())
 }
