@@ -22,7 +22,7 @@
 //! weight is `κs` times an intensity path scattered at `π̃`. The estimator
 //! samples that continuation; near (not at) that end the variance grows as
 //! `1/(π̃ − x)`, which the tail diagnostic reports.
-use super::walk::{Events, attenuation, intensity_weight, scatter_direction, walk};
+use super::walk::{Events, intensity_weight, scatter_direction, score, walk};
 use super::{Direction, PARAMETER, Probe, Rod};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
@@ -97,7 +97,7 @@ impl Estimator for ExpectationEstimator {
         }
         let mut v = DomainVelocity::default();
         let exit = walk(rod, self.probe.x, dir, rng, &mut v);
-        let w = rod.incoming_at(exit.side) * attenuation(rod, exit.length);
+        let w = score(rod, exit.side, exit.length);
         weights[0] = w;
         weights[1] = w * (v.divergence - rod.ke * v.length);
     }

@@ -7,7 +7,7 @@
 //! `(κs/2) e^{−κa L} Ŵ(π̃, +1)`.
 //!
 //! The primary path is an intensity path too, so `I` comes for free.
-use super::walk::{attenuation, intensity_weight, walk};
+use super::walk::{score, walk};
 use super::{Direction, PARAMETER, Probe, Rod, Side};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
@@ -34,21 +34,21 @@ impl Estimator for RenderingEstimator {
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
         let rod = &self.rod;
         let exit = walk(rod, self.probe.x, self.probe.omega.reverse(), rng, &mut ());
-        let a = attenuation(rod, exit.length);
         match exit.side {
             Side::Start => {
-                weights[0] = rod.incoming * a;
+                weights[0] = score(rod, Side::Start, exit.length);
                 weights[1] = 0.0;
             }
             Side::End => {
                 weights[0] = 0.0;
-                // I(π̃, +1) is seen by a backward path from π̃ travelling left.
-                let nested = if rod.ks > 0.0 {
-                    intensity_weight(rod, rod.length, Direction::Left, rng)
+                // I(π̃, +1) is seen by a backward path from π̃ travelling left;
+                // its absorption and the primary's share one exponential.
+                weights[1] = if rod.ks > 0.0 {
+                    let nested = walk(rod, rod.length, Direction::Left, rng, &mut ());
+                    0.5 * rod.ks * score(rod, nested.side, exit.length + nested.length)
                 } else {
                     0.0
                 };
-                weights[1] = 0.5 * rod.ks * a * nested;
             }
         }
     }

@@ -88,7 +88,17 @@ pub fn walk<E: Events>(
 #[inline]
 pub fn intensity_weight(rod: &Rod, x: f64, dir: Direction, rng: &mut PathRng) -> f64 {
     let exit = walk(rod, x, dir, rng, &mut ());
-    rod.incoming_at(exit.side) * attenuation(rod, exit.length)
+    score(rod, exit.side, exit.length)
+}
+
+/// The incoming intensity at `side` attenuated over `length`: `Î e^{−κa L}`,
+/// without evaluating the exponential where nothing enters.
+#[inline]
+pub fn score(rod: &Rod, side: Side, length: f64) -> f64 {
+    match side {
+        Side::Start => rod.incoming * attenuation(rod, length),
+        Side::End => 0.0,
+    }
 }
 
 /// Absorption along a path of length `l`, `e^{−κa l}`.
