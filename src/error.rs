@@ -19,6 +19,9 @@ pub enum Error {
     /// The run configuration cannot be honoured (thread pool, sample count).
     #[error("invalid run configuration: {0}")]
     Config(String),
+    /// Writing a result (figure, table) failed.
+    #[error("{0}")]
+    Output(String),
 }
 
 /// Checks that `value` is finite and satisfies `ok`, or names it in an error.

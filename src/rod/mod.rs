@@ -13,6 +13,7 @@ use crate::estimator::Estimator;
 
 pub mod exact;
 pub mod expectation;
+pub mod figures;
 pub mod intensity;
 pub mod rendering;
 pub mod transport;

@@ -1,0 +1,352 @@
+//! Figures as plain data, drawn by plotters to PNG and SVG.
+//!
+//! A [`Figure`] is a grid of [`Panel`]s; a panel holds [`Series`] (lines,
+//! points with ±σ error bars) or one heat map. The experiments build figures
+//! from their results and [`Figure::save`] writes `name.png` and `name.svg`.
+//! Log axes are drawn by plotting `log10` of the data on linear axes with
+//! `10^k` tick labels, so one code path serves every panel.
+use crate::error::Error;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// What a series draws.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Mark {
+    /// A polyline through `(x, y)`.
+    Line(Vec<(f64, f64)>),
+    /// A dashed polyline through `(x, y)`.
+    Dashed(Vec<(f64, f64)>),
+    /// Points `(x, mean, σ)` with ±σ error bars.
+    Points(Vec<(f64, f64, f64)>),
+}
+
+/// One labelled series of a panel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Legend label (empty: no legend entry).
+    pub label: String,
+    /// Index into the palette.
+    pub color: usize,
+    /// The data.
+    pub mark: Mark,
+}
+
+impl Series {
+    /// A line series.
+    pub fn line(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Line(xy),
+        }
+    }
+
+    /// A dashed line series.
+    pub fn dashed(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Dashed(xy),
+        }
+    }
+
+    /// Points with ±σ error bars.
+    pub fn points(label: &str, color: usize, xys: Vec<(f64, f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Points(xys),
+        }
+    }
+}
+
+/// A heat map over a grid of cells.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeatMap {
+    /// Cell edges along x (`nx + 1` values, in axis units).
+    pub x_edges: Vec<f64>,
+    /// Cell edges along y (`ny + 1` values, in axis units).
+    pub y_edges: Vec<f64>,
+    /// `values[iy * nx + ix]`; NaN draws grey.
+    pub values: Vec<f64>,
+    /// Values mapped to the two ends of the colour scale.
+    pub range: (f64, f64),
+}
+
+/// One chart.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Panel {
+    /// Caption above the chart.
+    pub title: String,
+    /// Label of the x axis.
+    pub x_label: String,
+    /// Label of the y axis.
+    pub y_label: String,
+    /// Logarithmic x axis.
+    pub x_log: bool,
+    /// Logarithmic y axis.
+    pub y_log: bool,
+    /// The series drawn.
+    pub series: Vec<Series>,
+    /// A heat map drawn under the series.
+    pub heat: Option<HeatMap>,
+    /// Where the legend goes.
+    pub legend: Legend,
+}
+
+/// Legend placement inside a panel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Legend {
+    /// Upper right corner.
+    #[default]
+    UpperRight,
+    /// Upper left corner.
+    UpperLeft,
+    /// Lower left corner.
+    LowerLeft,
+    /// Lower right corner.
+    LowerRight,
+}
+
+/// A grid of panels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// Panels, row by row.
+    pub panels: Vec<Panel>,
+    /// Panels per row.
+    pub columns: usize,
+    /// Size of one panel in pixels.
+    pub panel_size: (u32, u32),
+}
+
+/// The palette: colour-blind-safe (Okabe–Ito).
+pub const PALETTE: [RGBColor; 8] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+    RGBColor(240, 228, 66),
+];
+
+fn plot_err<E: std::fmt::Debug>(e: E) -> Error {
+    Error::Output(format!("plotting failed: {e:?}"))
+}
+
+/// `v` in axis units (log10 on log axes); `None` if not drawable.
+fn axis(v: f64, log: bool) -> Option<f64> {
+    let a = if log { v.log10() } else { v };
+    a.is_finite().then_some(a)
+}
+
+/// Data range of a panel in axis units, padded.
+fn bounds(p: &Panel) -> ((f64, f64), (f64, f64)) {
+    let (mut xs, mut ys) = (Vec::new(), Vec::new());
+    for s in &p.series {
+        match &s.mark {
+            Mark::Line(v) | Mark::Dashed(v) => v.iter().for_each(|&(x, y)| {
+                xs.push(axis(x, p.x_log));
+                ys.push(axis(y, p.y_log));
+            }),
+            Mark::Points(v) => v.iter().for_each(|&(x, m, e)| {
+                xs.push(axis(x, p.x_log));
+                ys.push(axis(m - e, p.y_log));
+                ys.push(axis(m + e, p.y_log));
+                ys.push(axis(m, p.y_log));
+            }),
+        }
+    }
+    if let Some(h) = &p.heat {
+        xs.extend(h.x_edges.iter().map(|&x| Some(x)));
+        ys.extend(h.y_edges.iter().map(|&y| Some(y)));
+    }
+    let span = |v: Vec<Option<f64>>, pad: f64| {
+        let v: Vec<f64> = v.into_iter().flatten().collect();
+        let lo = v.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        if !lo.is_finite() {
+            return (0.0, 1.0);
+        }
+        let w = if hi > lo { hi - lo } else { lo.abs().max(1.0) };
+        (lo - pad * w, hi + pad * w)
+    };
+    let pad = if p.heat.is_some() { 0.0 } else { 0.04 };
+    (span(xs, pad), span(ys, pad))
+}
+
+/// A colour on a blue–white–red scale for `t ∈ [0, 1]`.
+pub fn diverging(t: f64) -> RGBColor {
+    let t = t.clamp(0.0, 1.0);
+    let lerp = |a: f64, b: f64, u: f64| (a + (b - a) * u).round() as u8;
+    if t < 0.5 {
+        let u = t / 0.5;
+        RGBColor(
+            lerp(33.0, 247.0, u),
+            lerp(102.0, 247.0, u),
+            lerp(172.0, 247.0, u),
+        )
+    } else {
+        let u = (t - 0.5) / 0.5;
+        RGBColor(
+            lerp(247.0, 178.0, u),
+            lerp(247.0, 24.0, u),
+            lerp(247.0, 43.0, u),
+        )
+    }
+}
+
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), Error> {
+    let ((x0, x1), (y0, y1)) = bounds(p);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&p.title, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(plot_err)?;
+    let fmt_x = |v: &f64| tick(*v, p.x_log);
+    let fmt_y = |v: &f64| tick(*v, p.y_log);
+    chart
+        .configure_mesh()
+        .x_desc(p.x_label.as_str())
+        .y_desc(p.y_label.as_str())
+        .x_label_formatter(&fmt_x)
+        .y_label_formatter(&fmt_y)
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(plot_err)?;
+    if let Some(h) = &p.heat {
+        let nx = h.x_edges.len() - 1;
+        let cells = h.values.iter().enumerate().map(|(i, &v)| {
+            let (ix, iy) = (i % nx, i / nx);
+            let color = if v.is_finite() {
+                diverging((v - h.range.0) / (h.range.1 - h.range.0))
+            } else {
+                RGBColor(160, 160, 160)
+            };
+            Rectangle::new(
+                [
+                    (h.x_edges[ix], h.y_edges[iy]),
+                    (h.x_edges[ix + 1], h.y_edges[iy + 1]),
+                ],
+                color.filled(),
+            )
+        });
+        chart.draw_series(cells).map_err(plot_err)?;
+    }
+    let mut legend = false;
+    for s in &p.series {
+        let color = PALETTE[s.color % PALETTE.len()];
+        let to_axis = |&(x, y): &(f64, f64)| Some((axis(x, p.x_log)?, axis(y, p.y_log)?));
+        let anno = match &s.mark {
+            Mark::Line(v) => chart
+                .draw_series(LineSeries::new(
+                    v.iter().filter_map(to_axis),
+                    color.stroke_width(2),
+                ))
+                .map_err(plot_err)?,
+            Mark::Dashed(v) => chart
+                .draw_series(DashedLineSeries::new(
+                    v.iter().filter_map(to_axis),
+                    6,
+                    4,
+                    color.stroke_width(1),
+                ))
+                .map_err(plot_err)?,
+            Mark::Points(v) => chart
+                .draw_series(v.iter().filter_map(|&(x, m, e)| {
+                    let x = axis(x, p.x_log)?;
+                    let mid = axis(m, p.y_log)?;
+                    let lo = axis(m - e, p.y_log).unwrap_or(y0);
+                    let hi = axis(m + e, p.y_log)?;
+                    Some(ErrorBar::new_vertical(x, lo, mid, hi, color.filled(), 6))
+                }))
+                .map_err(plot_err)?,
+        };
+        if !s.label.is_empty() {
+            legend = true;
+            anno.label(s.label.as_str()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
+        }
+    }
+    if legend {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(match p.legend {
+                Legend::UpperRight => SeriesLabelPosition::UpperRight,
+                Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
+                Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
+                Legend::LowerRight => SeriesLabelPosition::LowerRight,
+            })
+            .draw()
+            .map_err(plot_err)?;
+    }
+    Ok(())
+}
+
+/// Tick label: the value, or `10^v` on a log axis.
+fn tick(v: f64, log: bool) -> String {
+    if log {
+        let p = 10f64.powf(v);
+        if (v - v.round()).abs() < 1e-9 {
+            format!("1e{}", v.round())
+        } else {
+            format!("{p:.1e}")
+        }
+    } else if v.abs() < 1e-12 {
+        "0".into()
+    } else if v.abs() < 1e-2 || v.abs() >= 1e4 {
+        format!("{v:.1e}")
+    } else {
+        format!("{v:.3}")
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    }
+}
+
+impl Figure {
+    /// A figure of `panels`, `columns` per row, 640×440 pixels each.
+    pub fn new(panels: Vec<Panel>, columns: usize) -> Figure {
+        Figure {
+            panels,
+            columns: columns.max(1),
+            panel_size: (640, 440),
+        }
+    }
+
+    fn size(&self) -> (u32, u32) {
+        let rows = self.panels.len().div_ceil(self.columns) as u32;
+        (
+            self.panel_size.0 * self.columns as u32,
+            self.panel_size.1 * rows.max(1),
+        )
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), Error> {
+        root.fill(&WHITE).map_err(plot_err)?;
+        let rows = self.panels.len().div_ceil(self.columns).max(1);
+        let areas = root.split_evenly((rows, self.columns));
+        for (p, area) in self.panels.iter().zip(areas.iter()) {
+            draw_panel(area, p)?;
+        }
+        root.present().map_err(plot_err)
+    }
+
+    /// Writes `dir/name.png` and `dir/name.svg`, creating `dir`.
+    pub fn save(&self, dir: &Path, name: &str) -> Result<Vec<PathBuf>, Error> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::Output(format!("cannot create {}: {e}", dir.display())))?;
+        let png = dir.join(format!("{name}.png"));
+        let svg = dir.join(format!("{name}.svg"));
+        self.draw(BitMapBackend::new(&png, self.size()).into_drawing_area())?;
+        self.draw(SVGBackend::new(&svg, self.size()).into_drawing_area())?;
+        Ok(vec![png, svg])
+    }
+}
