@@ -1,0 +1,404 @@
+//! The `geosens` command line.
+//!
+//! - `geosens rod --method M --ks F --ke F --length F --x F --omega ±1 [--json]`
+//!   estimates `I`, `s = ∂I/∂length` (and `∂I/∂x` for `transport`) at one
+//!   probe on a rod with one method, or evaluates the exact solution
+//!   (`--method exact`), and prints a table or one JSON line;
+//! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
+//!   and thick rods at a few probes and prints them beside the exact solution.
+//!
+//! Bad input exits with status 1 and `error: …` naming the value (clap's own
+//! parse errors exit with status 2).
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use geosens::rod::{Direction, Method as McMethod, Probe, Rod, exact};
+use geosens::{Error, Estimate, Quantity, RunConfig, RunResult, run};
+use serde::Serialize;
+use std::io::{self, Write};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Most worker threads accepted by `--threads`: beyond it a pool would cost
+/// more to start than the runs it serves (and rayon itself stops at 65535).
+const MAX_THREADS: usize = 1024;
+
+/// Monte Carlo estimates of intensity and geometric sensitivities.
+#[derive(Debug, Parser)]
+#[command(name = "geosens", version, about)]
+struct Cli {
+    /// What to run.
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Estimate I, ∂I/∂length (and ∂I/∂x) at one probe on a rod.
+    Rod(RodArgs),
+    /// Compare the four methods with the exact solution on the paper's rods.
+    Compare(RunArgs),
+}
+
+/// How to estimate: the method, the rod, the probe and the run. Float values
+/// may start with `-` (`--omega -1`, `--x -inf`) so that the library, not the
+/// parser, rejects them with its domain in the message.
+#[derive(Debug, Args)]
+#[command(allow_negative_numbers = true)]
+struct RodArgs {
+    /// Estimation method (`exact` evaluates the Bellman–Wing solution).
+    #[arg(long, value_enum)]
+    method: Method,
+    /// Scattering coefficient κs (≥ 0).
+    #[arg(long, allow_hyphen_values = true)]
+    ks: f64,
+    /// Extinction coefficient κe (≥ κs).
+    #[arg(long, allow_hyphen_values = true)]
+    ke: f64,
+    /// Rod length π̃ (> 0), the shape parameter.
+    #[arg(long, allow_hyphen_values = true)]
+    length: f64,
+    /// Probe position x, 0 ≤ x ≤ length.
+    #[arg(long, allow_hyphen_values = true)]
+    x: f64,
+    /// Probe direction ω: 1 (right) or -1 (left).
+    #[arg(long, allow_hyphen_values = true)]
+    omega: f64,
+    /// The run configuration.
+    #[command(flatten)]
+    run: RunArgs,
+    /// Print one JSON line instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Run configuration, shared by both subcommands.
+#[derive(Debug, Args)]
+struct RunArgs {
+    /// Number of paths per run, at least 2 [default: 1000000 for `rod`,
+    /// 200000 for `compare`] (`exact` samples none but checks it too).
+    #[arg(long)]
+    paths: Option<u64>,
+    /// Seed of the random streams.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Worker threads, 0 = all cores (results do not depend on it).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+}
+
+impl RunArgs {
+    /// The validated configuration, `default_paths` if `--paths` is absent,
+    /// with `--threads` capped at [`MAX_THREADS`].
+    fn config(&self, default_paths: u64) -> Result<RunConfig, Error> {
+        if self.threads > MAX_THREADS {
+            return Err(Error::Config(format!(
+                "threads = {}: expected 0 (all cores) to {MAX_THREADS}",
+                self.threads
+            )));
+        }
+        let cfg = RunConfig::new(self.paths.unwrap_or(default_paths), self.seed)?;
+        Ok(cfg.threads(self.threads))
+    }
+}
+
+/// `--method`: the exact solution or one of the four Monte Carlo methods.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Method {
+    /// Exact Bellman–Wing solution.
+    Exact,
+    /// Backward path tracing of I only.
+    Intensity,
+    /// Expectation differentiation: I and s from the same paths.
+    Expectation,
+    /// Differentiable rendering with double randomization.
+    Rendering,
+    /// Coupled transport of I, s and ∂I/∂x.
+    Transport,
+}
+
+impl Method {
+    /// The library's Monte Carlo method, `None` for `exact`.
+    fn monte_carlo(self) -> Option<McMethod> {
+        match self {
+            Method::Exact => None,
+            Method::Intensity => Some(McMethod::Intensity),
+            Method::Expectation => Some(McMethod::Expectation),
+            Method::Rendering => Some(McMethod::Rendering),
+            Method::Transport => Some(McMethod::Transport),
+        }
+    }
+}
+
+/// The three quantities a rod run can report, in table and JSON order.
+fn quantities() -> [Quantity; 3] {
+    [
+        Quantity::Intensity,
+        Quantity::sensitivity(geosens::rod::PARAMETER),
+        Quantity::gradient("x"),
+    ]
+}
+
+/// Position of `q` in [`quantities`].
+fn slot(q: &Quantity) -> usize {
+    match q {
+        Quantity::Intensity => 0,
+        Quantity::Sensitivity(_) => 1,
+        Quantity::Gradient(_) => 2,
+    }
+}
+
+/// The exact values of [`quantities`] at a probe.
+fn exact_values(rod: &Rod, probe: &Probe) -> [f64; 3] {
+    let e = exact::solve(rod, probe.x, probe.omega);
+    [e.intensity, e.sensitivity, e.gradient_x]
+}
+
+/// The exact solution as a [`RunResult`] (stderr 0, `paths` 0: nothing is
+/// sampled; `seconds` is the time of the evaluation).
+fn exact_result(rod: &Rod, probe: &Probe) -> RunResult {
+    let start = Instant::now();
+    let values = exact_values(rod, probe);
+    let seconds = start.elapsed().as_secs_f64();
+    RunResult {
+        method: "exact",
+        estimates: quantities()
+            .into_iter()
+            .zip(values.map(Estimate::exact))
+            .collect(),
+        paths: 0,
+        seconds,
+    }
+}
+
+/// Mean and standard error, as the JSON line prints them.
+#[derive(Serialize)]
+struct MeanErr {
+    /// Estimated value.
+    mean: f64,
+    /// Its standard error (0 for `exact`).
+    stderr: f64,
+}
+
+/// The one JSON line of `geosens rod --json`; `None` prints `null` for a
+/// quantity the method does not estimate.
+#[derive(Serialize)]
+struct JsonLine<'a> {
+    /// Method name.
+    method: &'a str,
+    /// `I`.
+    intensity: Option<MeanErr>,
+    /// `∂I/∂length`.
+    sensitivity: Option<MeanErr>,
+    /// `∂I/∂x`.
+    gradient_x: Option<MeanErr>,
+    /// Paths sampled (0 for `exact`).
+    paths: u64,
+    /// Wall time of the sampling (or evaluation), in seconds.
+    seconds: f64,
+}
+
+/// `geosens rod`.
+fn rod_command(args: &RodArgs, out: &mut impl Write) -> Result<(), Box<dyn std::error::Error>> {
+    let rod = Rod::new(args.ks, args.ke, args.length)?;
+    let probe = Probe::new(&rod, args.x, Direction::from_sign(args.omega)?)?;
+    let cfg = args.run.config(1_000_000)?;
+    let result = match args.method.monte_carlo() {
+        Some(m) => run(m.estimator(rod, probe).as_ref(), &cfg)?,
+        None => exact_result(&rod, &probe),
+    };
+    // serde_json would print a NaN as `null`, indistinguishable from "not
+    // estimated": refuse instead.
+    if let Some((q, e)) = result
+        .estimates
+        .iter()
+        .find(|(_, e)| !(e.mean.is_finite() && e.stderr.is_finite()))
+    {
+        return Err(format!(
+            "method {} gives {q} = {} ± {} at these inputs (floating-point overflow)",
+            result.method, e.mean, e.stderr
+        )
+        .into());
+    }
+    if args.json {
+        let [i, s, g] = quantities().map(|q| {
+            result.get(&q).map(|e| MeanErr {
+                mean: e.mean,
+                stderr: e.stderr,
+            })
+        });
+        let line = JsonLine {
+            method: result.method,
+            intensity: i,
+            sensitivity: s,
+            gradient_x: g,
+            paths: result.paths,
+            seconds: result.seconds,
+        };
+        writeln!(out, "{}", serde_json::to_string(&line)?)?;
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "rod κs = {:?}, κe = {:?}, length {:?}; probe x = {:?}, ω = {:+}",
+        rod.ks,
+        rod.ke,
+        rod.length,
+        probe.x,
+        probe.omega.sign()
+    )?;
+    writeln!(
+        out,
+        "method {}: {} paths, seed {}, {:.3} s",
+        result.method, result.paths, cfg.seed, result.seconds
+    )?;
+    writeln!(
+        out,
+        "{:<12} {:>14} {:>11} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
+        "quantity", "mean", "stderr", "n", "vov", "max_share", "reliable", "exact", "z"
+    )?;
+    let exact = exact_values(&rod, &probe);
+    for (q, e) in &result.estimates {
+        let ex = exact[slot(q)];
+        let mc = e.n > 0;
+        writeln!(
+            out,
+            "{:<12} {:>14.6e} {:>11.2e} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
+            q.to_string(),
+            e.mean,
+            e.stderr,
+            e.n,
+            dash(mc, || format!("{:.1e}", e.vov)),
+            dash(mc, || format!("{:.1e}", e.max_share)),
+            dash(mc, || yes_no(e.is_reliable()).to_owned()),
+            dash(mc, || format!("{ex:.6e}")),
+            dash(mc, || format!("{:.1}", e.z_score(ex))),
+        )?;
+    }
+    Ok(())
+}
+
+/// `text()` if `show`, else `-`.
+fn dash(show: bool, text: impl FnOnce() -> String) -> String {
+    if show { text() } else { "-".to_owned() }
+}
+
+/// `yes` or `no`.
+fn yes_no(b: bool) -> &'static str {
+    if b { "yes" } else { "no" }
+}
+
+/// The paper's rods: name, κs, κe (length 2).
+const RODS: [(&str, f64, f64); 2] = [("thin", 0.07, 0.1), ("thick", 2.1, 3.0)];
+/// Probe positions of the comparison.
+const XS: [f64; 4] = [0.0, 1.0, 1.9, 2.0];
+/// Width of one quantity cell of the comparison table.
+const CELL: usize = 32;
+
+/// One comparison cell: `mean ± stderr z`, a `!` if the error bar is
+/// unreliable, the bare value for an exact estimate (`n = 0`), `-` if absent.
+fn cell(e: Option<Estimate>, exact: f64) -> String {
+    match e {
+        None => format!("{:>10}", "-"),
+        Some(e) if e.n == 0 => format!("{:>10.6}", e.mean),
+        Some(e) => format!(
+            "{:>10.6} ± {:<7.1e} z {:>4.1}{}",
+            e.mean,
+            e.stderr,
+            e.z_score(exact),
+            if e.is_reliable() { "" } else { "!" }
+        ),
+    }
+}
+
+/// One row of the comparison table: probe label, method, one cell per
+/// quantity, reliability of the whole row, sampling time.
+fn row(label: &str, r: &RunResult, exact: &[f64; 3]) -> String {
+    let qs = quantities();
+    let cells: Vec<String> = qs
+        .iter()
+        .zip(exact)
+        .map(|(q, &x)| format!("{:<CELL$}", cell(r.get(q), x)))
+        .collect();
+    let reliable = r.estimates.iter().all(|(_, e)| e.is_reliable());
+    format!(
+        "{label:<10} {:<12} {} {:>8} {:>9.3}",
+        r.method,
+        cells.join(" "),
+        if r.paths == 0 { "-" } else { yes_no(reliable) },
+        r.seconds
+    )
+}
+
+/// `geosens compare`.
+fn compare_command(args: &RunArgs, out: &mut impl Write) -> Result<(), Box<dyn std::error::Error>> {
+    let cfg = args.config(200_000)?;
+    let start = Instant::now();
+    // Per method: total sampling time, largest z-score, unreliable estimates.
+    let mut totals = [(0.0, 0.0f64, 0usize); 4];
+    for (name, ks, ke) in RODS {
+        let rod = Rod::new(ks, ke, 2.0)?;
+        writeln!(
+            out,
+            "\n{name} rod: κs = {ks}, κe = {ke}, length 2; {} paths per run, seed {}",
+            cfg.paths, cfg.seed
+        )?;
+        writeln!(
+            out,
+            "{:<10} {:<12} {:<CELL$} {:<CELL$} {:<CELL$} {:>8} {:>9}",
+            "x, ω", "method", "I", "∂I/∂length", "∂I/∂x", "reliable", "time [s]"
+        )?;
+        for x in XS {
+            for omega in [Direction::Right, Direction::Left] {
+                let probe = Probe::new(&rod, x, omega)?;
+                let ex = exact_values(&rod, &probe);
+                let label = format!("{x}, {:+}", omega.sign());
+                writeln!(out, "{}", row(&label, &exact_result(&rod, &probe), &ex))?;
+                for (m, total) in McMethod::ALL.iter().zip(&mut totals) {
+                    let r = run(m.estimator(rod, probe).as_ref(), &cfg)?;
+                    writeln!(out, "{}", row("", &r, &ex))?;
+                    total.0 += r.seconds;
+                    for (q, e) in &r.estimates {
+                        total.1 = total.1.max(e.z_score(ex[slot(q)]));
+                        total.2 += usize::from(!e.is_reliable());
+                    }
+                }
+            }
+        }
+    }
+    writeln!(
+        out,
+        "\nper method over the 16 probes (z: distance to exact in stderrs; \
+         !: VOV ≥ {}, error bar unreliable)",
+        Estimate::VOV_LIMIT
+    )?;
+    writeln!(
+        out,
+        "{:<12} {:>9} {:>7} {:>11}",
+        "method", "time [s]", "max z", "unreliable"
+    )?;
+    for (m, (seconds, z, bad)) in McMethod::ALL.iter().zip(totals) {
+        writeln!(out, "{:<12} {seconds:>9.3} {z:>7.1} {bad:>11}", m.name())?;
+    }
+    writeln!(
+        out,
+        "total wall time {:.2} s",
+        start.elapsed().as_secs_f64()
+    )?;
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let mut out = io::stdout().lock();
+    let result = match &cli.command {
+        Command::Rod(args) => rod_command(args, &mut out),
+        Command::Compare(args) => compare_command(args, &mut out),
+    };
+    match result.and_then(|()| Ok(out.flush()?)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,301 @@
+//! The `geosens` binary: JSON shape, agreement with the library and the exact
+//! solution, thread-count independence, and rejection of bad input.
+use geosens::rod::{Direction, Rod, exact};
+use serde_json::Value;
+use std::process::{Command, Output};
+
+/// The thick rod and probe most tests use.
+const PROBE: [&str; 10] = [
+    "--ks", "2.1", "--ke", "3", "--length", "2", "--x", "1.9", "--omega", "-1",
+];
+
+/// Runs the binary with `args`.
+fn geosens(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_geosens"))
+        .args(args)
+        .output()
+        .expect("the geosens binary runs")
+}
+
+/// `geosens rod --method <method> <PROBE> <extra> --json`: its stdout, which
+/// must be one line.
+fn json_line(method: &str, extra: &[&str]) -> String {
+    let mut args = vec!["rod", "--method", method];
+    args.extend(PROBE);
+    args.extend(extra);
+    args.push("--json");
+    let out = geosens(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?} failed: {stderr}");
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(stdout.lines().count(), 1, "not one line: {stdout}");
+    stdout.trim_end().to_owned()
+}
+
+/// The parsed JSON line.
+fn json(method: &str, extra: &[&str]) -> Value {
+    serde_json::from_str(&json_line(method, extra)).expect("valid JSON")
+}
+
+/// `v[key]["mean"]` and `v[key]["stderr"]`.
+fn mean_err(v: &Value, key: &str) -> (f64, f64) {
+    (
+        v[key]["mean"].as_f64().unwrap(),
+        v[key]["stderr"].as_f64().unwrap(),
+    )
+}
+
+/// The exact solution at [`PROBE`].
+fn exact_at_probe() -> exact::Solution {
+    let rod = Rod::new(2.1, 3.0, 2.0).unwrap();
+    exact::solve(&rod, 1.9, Direction::Left)
+}
+
+#[test]
+fn json_has_exactly_the_documented_keys_and_nulls() {
+    // (method, which of intensity / sensitivity / gradient_x it estimates)
+    let cases = [
+        ("exact", [true, true, true]),
+        ("intensity", [true, false, false]),
+        ("expectation", [true, true, false]),
+        ("rendering", [true, true, false]),
+        ("transport", [true, true, true]),
+    ];
+    for (method, present) in cases {
+        let v = json(method, &["--paths", "1000"]);
+        let obj = v.as_object().unwrap();
+        let keys: Vec<&str> = obj.keys().map(String::as_str).collect();
+        let mut expected = vec![
+            "method",
+            "intensity",
+            "sensitivity",
+            "gradient_x",
+            "paths",
+            "seconds",
+        ];
+        expected.sort_unstable();
+        let mut sorted = keys.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, expected, "{method}");
+        assert_eq!(v["method"], method);
+        for (key, present) in ["intensity", "sensitivity", "gradient_x"]
+            .iter()
+            .zip(present)
+        {
+            if present {
+                let q = v[key].as_object().unwrap();
+                assert_eq!(q.len(), 2, "{method} {key}: {q:?}");
+                assert!(q["mean"].is_f64() && q["stderr"].is_f64(), "{method} {key}");
+            } else {
+                assert!(v[key].is_null(), "{method}: {key} should be null");
+            }
+        }
+        let paths = if method == "exact" { 0 } else { 1000 };
+        assert_eq!(v["paths"].as_u64(), Some(paths), "{method}");
+        assert!(v["seconds"].as_f64().unwrap() >= 0.0);
+    }
+    // The keys come in the documented order.
+    let line = json_line("transport", &["--paths", "1000"]);
+    let pos: Vec<usize> = [
+        "\"method\"",
+        "\"intensity\"",
+        "\"sensitivity\"",
+        "\"gradient_x\"",
+        "\"paths\"",
+        "\"seconds\"",
+    ]
+    .iter()
+    .map(|k| line.find(k).unwrap())
+    .collect();
+    assert!(pos.is_sorted(), "{line}");
+}
+
+#[test]
+fn exact_matches_the_library() {
+    let v = json("exact", &[]);
+    let want = exact_at_probe();
+    for (key, want) in [
+        ("intensity", want.intensity),
+        ("sensitivity", want.sensitivity),
+        ("gradient_x", want.gradient_x),
+    ] {
+        let (mean, stderr) = mean_err(&v, key);
+        assert_eq!(stderr, 0.0, "{key}");
+        // serde_json's default float parser may be off by one unit in the
+        // last place; the printed text is the shortest round-trip form.
+        assert!(
+            (mean - want).abs() <= 2.0 * f64::EPSILON * want.abs(),
+            "{key}: {mean} vs {want}"
+        );
+    }
+}
+
+#[test]
+fn monte_carlo_agrees_with_exact() {
+    let want = exact_at_probe();
+    for method in ["intensity", "expectation", "rendering", "transport"] {
+        let v = json(method, &["--paths", "200000", "--seed", "3"]);
+        for (key, want) in [
+            ("intensity", want.intensity),
+            ("sensitivity", want.sensitivity),
+            ("gradient_x", want.gradient_x),
+        ] {
+            if v[key].is_null() {
+                continue;
+            }
+            let (mean, stderr) = mean_err(&v, key);
+            assert!(stderr > 0.0, "{method} {key}");
+            let z = (mean - want).abs() / stderr;
+            assert!(
+                z < 5.0,
+                "{method} {key}: {mean} ± {stderr} vs {want} (z = {z})"
+            );
+        }
+    }
+}
+
+#[test]
+fn thread_count_does_not_change_results() {
+    for method in ["expectation", "transport"] {
+        let run = |threads| {
+            let line = json_line(
+                method,
+                &["--paths", "50000", "--seed", "11", "--threads", threads],
+            );
+            // Everything but the wall time must be byte-identical.
+            line[..line.find(",\"seconds\"").unwrap()].to_owned()
+        };
+        assert_eq!(run("1"), run("2"), "{method}");
+    }
+}
+
+#[test]
+fn readable_table_names_the_quantities() {
+    let mut args = vec!["rod", "--method", "transport", "--paths", "1000"];
+    args.extend(PROBE);
+    let out = geosens(&args);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for word in [
+        "I ",
+        "∂I/∂length",
+        "∂I/∂x",
+        "stderr",
+        "vov",
+        "reliable",
+        "exact",
+    ] {
+        assert!(text.contains(word), "missing {word:?} in\n{text}");
+    }
+}
+
+/// Asserts `args` fail with `code` and a message on stderr containing every
+/// one of `words`.
+fn assert_rejected(args: &[&str], code: i32, words: &[&str]) {
+    let out = geosens(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {stderr}");
+    assert!(out.stdout.is_empty(), "{args:?} printed to stdout");
+    for w in words {
+        assert!(stderr.contains(w), "{args:?}: {w:?} not in {stderr:?}");
+    }
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+}
+
+/// A rod command with `--flag value` replacing (or added to) the thick-rod
+/// probe and `--paths 1000`.
+fn rod_with(flag: &str, value: &str) -> Vec<String> {
+    let mut pairs: Vec<[&str; 2]> = PROBE.chunks(2).map(|p| [p[0], p[1]]).collect();
+    pairs.push(["--paths", "1000"]);
+    match pairs.iter_mut().find(|p| p[0] == flag) {
+        Some(p) => p[1] = value,
+        None => pairs.push([flag, value]),
+    }
+    let mut args = vec!["rod", "--method", "expectation"];
+    args.extend(pairs.concat());
+    args.into_iter().map(String::from).collect()
+}
+
+#[test]
+fn invalid_values_are_rejected_with_their_name() {
+    let cases = [
+        ("--ks", "-1", "ks = -1"),
+        ("--ke", "1", "ke = 1"), // below ks = 2.1
+        ("--length", "0", "length = 0"),
+        ("--length", "-2", "length = -2"),
+        ("--x", "-0.5", "x = -0.5"),
+        ("--x", "2.5", "x = 2.5"),
+        ("--omega", "0", "omega = 0"),
+        ("--omega", "2", "omega = 2"),
+        ("--paths", "1", "paths = 1"),
+        ("--paths", "0", "paths = 0"),
+        ("--ks", "NaN", "ks = NaN"),
+        ("--length", "inf", "length = inf"),
+        ("--x", "-inf", "x = -inf"),
+        ("--threads", "1000000000", "threads = 1000000000"),
+    ];
+    for (flag, value, message) in cases {
+        let args = rod_with(flag, value);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_rejected(&args, 1, &["error: ", message]);
+    }
+}
+
+#[test]
+fn exact_rejects_bad_paths_too() {
+    let mut args = vec!["rod", "--method", "exact", "--paths", "1"];
+    args.extend(PROBE);
+    assert_rejected(&args, 1, &["paths = 1"]);
+}
+
+#[test]
+fn extreme_inputs_give_numbers_or_an_error_never_null() {
+    // At κe = π̃ = 1e308 the exact solution may overflow; serde_json would
+    // print a NaN as null, so the binary must refuse rather than print it.
+    let args = [
+        "rod", "--method", "exact", "--ks", "1e308", "--ke", "1e308", "--length", "1e308", "--x",
+        "5e307", "--omega", "1", "--json",
+    ];
+    let out = geosens(&args);
+    if out.status.success() {
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        for key in ["intensity", "sensitivity", "gradient_x"] {
+            assert!(v[key]["mean"].is_f64(), "{key} is not a number: {v}");
+        }
+    } else {
+        assert_rejected(&args, 1, &["error: "]);
+    }
+}
+
+#[test]
+fn malformed_arguments_are_rejected_by_the_parser() {
+    let mut unknown = vec!["rod", "--method", "magic"];
+    unknown.extend(PROBE);
+    assert_rejected(&unknown, 2, &["magic", "--method"]);
+    assert_rejected(
+        &[
+            "rod", "--method", "exact", "--ks", "1", "--ke", "2", "--length", "2", "--x", "1",
+        ],
+        2,
+        &["--omega"],
+    );
+    let mut negative = vec!["rod", "--method", "exact", "--threads", "-1"];
+    negative.extend(PROBE);
+    assert_rejected(&negative, 2, &["-1", "--threads"]);
+    let mut word = vec!["rod", "--method", "exact", "--x", "one"];
+    word.extend(&PROBE[..6]);
+    word.extend(&PROBE[8..]);
+    assert_rejected(&word, 2, &["one", "--x"]);
+}
+
+#[test]
+fn compare_runs() {
+    let out = geosens(&["compare", "--paths", "2000", "--threads", "2"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    for word in ["thin rod", "thick rod", "exact", "transport", "reliable"] {
+        assert!(text.contains(word), "missing {word:?}");
+    }
+    assert_rejected(&["compare", "--paths", "1"], 1, &["paths = 1"]);
+}
