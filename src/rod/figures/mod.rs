@@ -60,6 +60,17 @@ impl FigureOptions {
         bar
     }
 
+    /// Writes `value` as pretty JSON to `out/name.json`: the numbers behind a
+    /// figure, for the book's text and for readers.
+    pub fn write_json<T: serde::Serialize>(&self, name: &str, value: &T) -> Result<PathBuf, Error> {
+        let io = |e: std::io::Error| Error::Output(format!("cannot write {name}.json: {e}"));
+        std::fs::create_dir_all(&self.out).map_err(io)?;
+        let path = self.out.join(format!("{name}.json"));
+        let text = serde_json::to_string_pretty(value).map_err(|e| Error::Output(e.to_string()))?;
+        std::fs::write(&path, text).map_err(io)?;
+        Ok(path)
+    }
+
     /// Runs `method` at `(x, omega)` with `paths` (scaled) paths and seed
     /// `self.seed + salt`.
     pub fn run(
