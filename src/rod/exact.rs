@@ -26,6 +26,7 @@ pub struct Solution {
     pub gradient_x: f64,
 }
 
+// ANCHOR: solve
 /// `(1 − e^{−t})/t`, 1 at `t = 0`, accurate for small `t`.
 fn one_minus_exp_over(t: f64) -> f64 {
     if t == 0.0 { 1.0 } else { -(-t).exp_m1() / t }
@@ -63,3 +64,4 @@ pub fn solve(rod: &Rod, x: f64, omega: Direction) -> Solution {
         },
     }
 }
+// ANCHOR_END: solve

@@ -27,6 +27,7 @@ use super::{Direction, PARAMETER, Probe, Rod};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
 
+// ANCHOR: domain_velocity
 /// The domain-deformation velocity, built incrementally along a path.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct DomainVelocity {
@@ -65,6 +66,7 @@ impl Events for DomainVelocity {
         self.length += self.border_velocity(dir);
     }
 }
+// ANCHOR_END: domain_velocity
 
 /// The expectation-differentiation estimator of `I` and `∂I/∂π̃`.
 #[derive(Debug, Clone, Copy)]
@@ -84,6 +86,7 @@ impl Estimator for ExpectationEstimator {
         vec![Quantity::Intensity, Quantity::sensitivity(PARAMETER)]
     }
 
+    // ANCHOR: sample
     #[inline]
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
         let rod = &self.rod;
@@ -101,4 +104,5 @@ impl Estimator for ExpectationEstimator {
         weights[0] = w;
         weights[1] = w * (v.divergence - rod.ke * v.length);
     }
+    // ANCHOR_END: sample
 }

@@ -30,6 +30,7 @@ impl Estimator for RenderingEstimator {
         vec![Quantity::Intensity, Quantity::sensitivity(PARAMETER)]
     }
 
+    // ANCHOR: sample
     #[inline]
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
         let rod = &self.rod;
@@ -52,4 +53,5 @@ impl Estimator for RenderingEstimator {
             }
         }
     }
+    // ANCHOR_END: sample
 }

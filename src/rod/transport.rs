@@ -25,6 +25,7 @@ use crate::rng::PathRng;
 /// The fields the rod transport model carries, in weight order.
 pub const FIELDS: usize = 3;
 
+// ANCHOR: boundary_sources
 /// Boundary sources `[I, s, ∂xI]` of the coupled fields at `side`, with the
 /// unknown intensity there estimated by one nested path.
 pub fn boundary_sources(rod: &Rod, side: Side, rng: &mut PathRng) -> [f64; FIELDS] {
@@ -52,7 +53,9 @@ pub fn boundary_sources(rod: &Rod, side: Side, rng: &mut PathRng) -> [f64; FIELD
         }
     }
 }
+// ANCHOR_END: boundary_sources
 
+// ANCHOR: solve
 /// One intensity sample, by the same solver with the intensity's sources.
 #[inline]
 fn nested_intensity(rod: &Rod, x: f64, dir: Direction, rng: &mut PathRng) -> f64 {
@@ -75,6 +78,7 @@ pub fn solve<const N: usize>(
     let a = attenuation(rod, exit.length);
     source(exit.side, rng).map(|s| a * s)
 }
+// ANCHOR_END: solve
 
 /// The transport-model estimator of `I`, `∂I/∂π̃` and `∂I/∂x`.
 #[derive(Debug, Clone, Copy)]

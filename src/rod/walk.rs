@@ -22,6 +22,7 @@ pub struct Exit {
     pub length: f64,
 }
 
+// ANCHOR: walk
 /// Observer of the events of a walk.
 pub trait Events {
     /// A collision after a free path `xi < d`, travelling along `dir`, `d`
@@ -82,6 +83,7 @@ pub fn walk<E: Events>(
         dir = scatter_direction(rng);
     }
 }
+// ANCHOR_END: walk
 
 /// One intensity sample from `x` along `dir`: the incoming intensity where
 /// the path leaves, attenuated by absorption, `Î e^{−κa L}` (Eq. 28).
