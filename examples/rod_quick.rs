@@ -5,7 +5,7 @@
 //! cargo run --release --example rod_quick
 //! ```
 use geosens::rod::{Direction, Method, Probe, Rod, exact};
-use geosens::{Error, Quantity, RunConfig, run};
+use geosens::{Error, RunConfig, run};
 
 fn main() -> Result<(), Error> {
     let cfg = RunConfig::new(1_000_000, 1)?;
@@ -32,17 +32,8 @@ fn main() -> Result<(), Error> {
                         .estimates
                         .iter()
                         .map(|(q, e)| {
-                            let reference = match q {
-                                Quantity::Intensity => ex.intensity,
-                                Quantity::Sensitivity(_) => ex.sensitivity,
-                                Quantity::Gradient(_) => ex.gradient_x,
-                            };
-                            format!(
-                                "{q} = {:.5} ± {:.5} (z {:.1})",
-                                e.mean,
-                                e.stderr,
-                                e.z_score(reference)
-                            )
+                            let z = e.z_score(ex.get(q));
+                            format!("{q} = {:.5} ± {:.5} (z {z:.1})", e.mean, e.stderr)
                         })
                         .collect();
                     println!("    {:<12} {}", method.name(), cells.join(", "));

@@ -27,6 +27,16 @@ fn rod_coefficients_are_validated() {
     ] {
         names(Rod::new(ks, ke, length).unwrap_err(), bad);
     }
+    // Optical thickness beyond the supported range (overflow, endless paths).
+    names(
+        Rod::new(1e308, 1e308, 1e308).unwrap_err(),
+        "optical thickness ke*length",
+    );
+    names(
+        Rod::new(0.0, 1e3, 11.0).unwrap_err(),
+        "optical thickness ke*length",
+    );
+    assert!(Rod::new(50.0, 50.0, 200.0).is_ok());
     let rod = Rod::new(0.5, 1.0, 1.0).unwrap();
     names(rod.with_incoming(-1.0).unwrap_err(), "incoming");
     names(rod.with_incoming(f64::NAN).unwrap_err(), "incoming");

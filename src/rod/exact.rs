@@ -14,6 +14,7 @@
 //! `0/0` at `κa = 0` (`k = 0`), exact at `κs = 0`. The book's chapter "The
 //! rod and its exact solution" has the derivation.
 use super::{Direction, Rod};
+use crate::estimator::Quantity;
 
 /// `I`, `∂I/∂π̃` and `∂I/∂x` at one point and direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,6 +28,18 @@ pub struct Solution {
 }
 
 // ANCHOR: solve
+impl Solution {
+    /// The exact value of `q`: `I`, `s` for any sensitivity, `∂xI` for any
+    /// gradient (the rod has one parameter and one axis).
+    pub fn get(&self, q: &Quantity) -> f64 {
+        match q {
+            Quantity::Intensity => self.intensity,
+            Quantity::Sensitivity(_) => self.sensitivity,
+            Quantity::Gradient(_) => self.gradient_x,
+        }
+    }
+}
+
 /// `(1 − e^{−t})/t`, 1 at `t = 0`, accurate for small `t`.
 fn one_minus_exp_over(t: f64) -> f64 {
     if t == 0.0 { 1.0 } else { -(-t).exp_m1() / t }

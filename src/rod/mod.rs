@@ -96,11 +96,22 @@ pub struct Rod {
 }
 
 impl Rod {
+    /// Largest optical thickness `κe π̃` a rod may have.
+    pub const MAX_OPTICAL_THICKNESS: f64 = 1e4;
+
     /// A rod with `I0 = 1`; errors name any value out of its domain.
     pub fn new(ks: f64, ke: f64, length: f64) -> Result<Rod, Error> {
         let ks = check("ks", ks, ks >= 0.0, "a finite number >= 0")?;
         let ke = check("ke", ke, ke >= ks, "a finite number >= ks")?;
         let length = check("length", length, length > 0.0, "a finite number > 0")?;
+        // Beyond this optical thickness the exact solution's products
+        // overflow and a conservative rod's paths take ~(κe π̃)² collisions.
+        check(
+            "optical thickness ke*length",
+            ke * length,
+            ke * length <= Self::MAX_OPTICAL_THICKNESS,
+            "at most 1e4",
+        )?;
         Ok(Rod {
             ks,
             ke,

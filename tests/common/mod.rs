@@ -29,12 +29,7 @@ pub fn estimate(
 
 /// The exact value of `q` at `(x, omega)`.
 pub fn exact_value(rod: &Rod, x: f64, omega: Direction, q: &Quantity) -> f64 {
-    let e = exact::solve(rod, x, omega);
-    match q {
-        Quantity::Intensity => e.intensity,
-        Quantity::Sensitivity(_) => e.sensitivity,
-        Quantity::Gradient(_) => e.gradient_x,
-    }
+    exact::solve(rod, x, omega).get(q)
 }
 
 /// `(quantity, z-score against the exact solution)` for every estimate of `r`.

@@ -111,12 +111,7 @@ pub fn thick() -> Rod {
 
 /// The exact value of `q` at `(x, omega)`.
 pub fn exact_value(rod: &Rod, x: f64, omega: Direction, q: &Quantity) -> f64 {
-    let e = exact::solve(rod, x, omega);
-    match q {
-        Quantity::Intensity => e.intensity,
-        Quantity::Sensitivity(_) => e.sensitivity,
-        Quantity::Gradient(_) => e.gradient_x,
-    }
+    exact::solve(rod, x, omega).get(q)
 }
 
 /// `n` evenly spaced positions over `[0, length]`, ends included.
