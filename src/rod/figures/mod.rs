@@ -12,6 +12,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 
 pub mod along;
+pub mod convergence;
+pub mod efficiency;
 
 /// What every figure function takes.
 #[derive(Debug, Clone)]
