@@ -27,7 +27,6 @@ pub struct Solution {
     pub gradient_x: f64,
 }
 
-// ANCHOR: solve
 impl Solution {
     /// The exact value of `q`: `I`, `s` for any sensitivity, `∂xI` for any
     /// gradient (the rod has one parameter and one axis).
@@ -40,6 +39,7 @@ impl Solution {
     }
 }
 
+// ANCHOR: solve
 /// `(1 − e^{−t})/t`, 1 at `t = 0`, accurate for small `t`.
 fn one_minus_exp_over(t: f64) -> f64 {
     if t == 0.0 { 1.0 } else { -(-t).exp_m1() / t }
