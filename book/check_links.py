@@ -1,0 +1,68 @@
+#!/usr/bin/env python3
+"""Check the internal links of the built book.
+
+Run after `mdbook build book`:
+
+    python3 book/check_links.py [book/book]
+
+Every relative `href`/`src` in the generated chapter pages must name a file
+that exists in the output, and every `#fragment` an `id` in the target page.
+External links (with a scheme) and site-absolute paths are not followed. Exits 1 on any broken link.
+"""
+import html.parser
+import pathlib
+import sys
+import urllib.parse
+
+
+class Page(html.parser.HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.links, self.ids = [], set()
+
+    def handle_starttag(self, tag, attrs):
+        for name, value in attrs:
+            if name == "id" and value:
+                self.ids.add(value)
+            if name in ("href", "src") and value is not None:
+                self.links.append(value)
+
+
+def parse(path):
+    page = Page()
+    page.feed(path.read_text(encoding="utf-8"))
+    return page
+
+
+def main():
+    root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "book/book").resolve()
+    if not (root / "index.html").is_file():
+        sys.exit(f"{root}: no index.html; run `mdbook build book` first")
+    pages = {p: parse(p) for p in root.rglob("*.html")}
+    broken = 0
+    for path, page in sorted(pages.items()):
+        for link in page.links:
+            url = urllib.parse.urlsplit(link)
+            if url.scheme or url.netloc or link.startswith(("mailto:", "javascript:")):
+                continue
+            if url.path.startswith("/"):
+                continue  # site-absolute (the 404 page's links): depends on site-url
+            target = (path.parent / urllib.parse.unquote(url.path)).resolve() if url.path else path
+            if target.is_dir():
+                target = target / "index.html"
+            if not target.is_file():
+                print(f"{path.relative_to(root)}: missing target {link}")
+                broken += 1
+                continue
+            frag = urllib.parse.unquote(url.fragment)
+            if frag and target.suffix == ".html":
+                ids = pages[target].ids if target in pages else parse(target).ids
+                if frag not in ids:
+                    print(f"{path.relative_to(root)}: no id {frag!r} in {link}")
+                    broken += 1
+    print(f"{len(pages)} pages, {sum(len(p.links) for p in pages.values())} links, {broken} broken")
+    sys.exit(1 if broken else 0)
+
+
+if __name__ == "__main__":
+    main()
