@@ -153,9 +153,42 @@ fn boundary_identities() {
 }
 
 #[test]
+fn sensitivities_are_positive_deep_in_thick_rods() {
+    // s(x,+1) = I0 b² S(x)/f(π̃)² and s(x,−1) = I0 b f(x)/f(π̃)²: positive for
+    // κs > 0 (x > 0 looking right), however small. A quotient-rule evaluation
+    // cancels to 0 or to the wrong sign here.
+    for (ks, ke, length) in [
+        (25.0, 50.0, 1.0),
+        (2.1, 3.0, 20.0),
+        (49.0, 50.0, 1.0),
+        (50.0, 50.0, 1.0),
+    ] {
+        let rod = Rod::new(ks, ke, length).unwrap();
+        for i in 0..=10 {
+            let x = length * i as f64 / 10.0;
+            let left = exact::solve(&rod, x, Direction::Left).sensitivity;
+            assert!(left > 0.0, "s({x}, -1) = {left} on {rod:?}");
+            if x > 0.0 {
+                let right = exact::solve(&rod, x, Direction::Right).sensitivity;
+                assert!(right > 0.0, "s({x}, +1) = {right} on {rod:?}");
+            }
+        }
+    }
+}
+
+#[test]
 fn very_thick_rods_do_not_overflow() {
-    for (ks, ke) in [(49.0, 50.0), (50.0, 50.0), (0.0, 50.0), (25.0, 50.0)] {
-        let rod = Rod::new(ks, ke, 1.0).unwrap();
+    // Up to the largest optical thickness a rod may have, kπ̃ far past the
+    // ≈ 710 where unscaled cosh overflows.
+    for (ks, ke, length) in [
+        (49.0, 50.0, 1.0),
+        (50.0, 50.0, 1.0),
+        (0.0, 50.0, 1.0),
+        (25.0, 50.0, 1.0),
+        (0.0, 1e4, 1.0),
+        (5e3, 1e4, 1.0),
+    ] {
+        let rod = Rod::new(ks, ke, length).unwrap();
         for x in [0.0, 0.5, 1.0] {
             for omega in [Direction::Right, Direction::Left] {
                 let e = exact::solve(&rod, x, omega);

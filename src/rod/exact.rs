@@ -8,7 +8,10 @@
 //! `I+ = I0 f(π̃−x)/f(π̃)`, `I− = I0 b S(π̃−x)/f(π̃)`, with
 //! `S(y) = sinh(ky)/k`, `C(y) = cosh(ky)`, `f = C + aS`, `f' = k²S + aC`.
 //!
-//! Then `∂xI = −∂y`, and `s = ∂π̃I` follows by the quotient rule. Every
+//! Then `∂xI = −∂y`, and `s = ∂π̃I` follows by the quotient rule, whose
+//! numerator hyperbolic identities turn into products (no cancellation deep
+//! in thick rods): `s(x,+1) = I0 b² S(x)/f(π̃)²`, `s(x,−1) = I0 b f(x)/f(π̃)²`.
+//! Every
 //! function is evaluated scaled by `e^{−ky}`, with `S(y)e^{−ky} =
 //! y·(1 − e^{−2ky})/(2ky)` through `expm1`: no overflow for thick rods, no
 //! `0/0` at `κa = 0` (`k = 0`), exact at `κs = 0`. The book's chapter "The
@@ -55,25 +58,27 @@ fn scaled(k: f64, y: f64) -> (f64, f64) {
 pub fn solve(rod: &Rod, x: f64, omega: Direction) -> Solution {
     let (a, b) = (rod.ke - 0.5 * rod.ks, 0.5 * rod.ks);
     let k = (rod.ke * rod.ka()).max(0.0).sqrt();
-    let y = rod.length - x;
-    let (c, s) = scaled(k, y);
-    let (cp, sp) = scaled(k, rod.length);
-    let f = |c: f64, s: f64| c + a * s;
-    let df = |c: f64, s: f64| k * k * s + a * c;
-    let g = f(cp, sp);
-    let dlog_g = df(cp, sp) / g;
-    // e^{−kx} relates the two scalings, e^{−ky}/e^{−kπ̃}.
+    let f = |(c, s): (f64, f64)| c + a * s;
+    let df = |(c, s): (f64, f64)| k * k * s + a * c;
+    let at_y = scaled(k, rod.length - x);
+    let at_x = scaled(k, x);
+    let g = f(scaled(k, rod.length));
+    // e^{−kx} relates the scalings of y = π̃ − x and π̃; e^{−k(2π̃−x)} those of
+    // x and π̃² in the sensitivity's product form.
     let scale = rod.incoming * (-k * x).exp() / g;
+    let scale_s = rod.incoming * b * (-k * (2.0 * rod.length - x)).exp() / (g * g);
     match omega {
         Direction::Right => Solution {
-            intensity: scale * f(c, s),
-            sensitivity: scale * (df(c, s) - f(c, s) * dlog_g),
-            gradient_x: -scale * df(c, s),
+            intensity: scale * f(at_y),
+            // f'(y) f(π̃) − f(y) f'(π̃) = b² S(x): no cancellation.
+            sensitivity: scale_s * b * at_x.1,
+            gradient_x: -scale * df(at_y),
         },
         Direction::Left => Solution {
-            intensity: scale * b * s,
-            sensitivity: scale * b * (c - s * dlog_g),
-            gradient_x: -scale * b * c,
+            intensity: scale * b * at_y.1,
+            // C(y) f(π̃) − S(y) f'(π̃) = f(x).
+            sensitivity: scale_s * f(at_x),
+            gradient_x: -scale * b * at_y.0,
         },
     }
 }

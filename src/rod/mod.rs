@@ -104,8 +104,8 @@ impl Rod {
         let ks = check("ks", ks, ks >= 0.0, "a finite number >= 0")?;
         let ke = check("ke", ke, ke >= ks, "a finite number >= ks")?;
         let length = check("length", length, length > 0.0, "a finite number > 0")?;
-        // Beyond this optical thickness the exact solution's products
-        // overflow and a conservative rod's paths take ~(κe π̃)² collisions.
+        // A conservative rod's paths take ~(κe π̃)² collisions: 10⁸ at the
+        // bound, beyond which a run would not end in any useful time.
         check(
             "optical thickness ke*length",
             ke * length,
