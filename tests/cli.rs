@@ -290,7 +290,14 @@ fn malformed_arguments_are_rejected_by_the_parser() {
 
 #[test]
 fn compare_runs() {
-    let out = geosens(&["compare", "--paths", "2000", "--threads", "2"]);
+    let out = geosens(&[
+        "compare",
+        "--paths",
+        "2000",
+        "--threads",
+        "2",
+        "--no-figures",
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     let text = String::from_utf8(out.stdout).unwrap();
@@ -298,4 +305,40 @@ fn compare_runs() {
         assert!(text.contains(word), "missing {word:?}");
     }
     assert_rejected(&["compare", "--paths", "1"], 1, &["paths = 1"]);
+    assert_rejected(&["compare", "--effort", "0"], 1, &["effort = 0"]);
+    assert_rejected(&["compare", "--effort", "nan"], 1, &["effort = NaN"]);
+}
+
+#[test]
+fn compare_writes_the_figures() {
+    let dir = std::env::temp_dir().join(format!("geosens-cli-figures-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let dir_arg = dir.to_str().unwrap();
+    let out = geosens(&[
+        "compare",
+        "--paths",
+        "1000",
+        "--effort",
+        "0.0001",
+        "--figures",
+        dir_arg,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in [
+        "intensity_along_rod",
+        "sensitivity_along_rod",
+        "convergence",
+        "efficiency",
+    ] {
+        for ext in ["png", "svg"] {
+            let path = dir.join(format!("{name}.{ext}"));
+            let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+            assert!(size > 1000, "{} missing or empty", path.display());
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -10,10 +10,11 @@
 //! Bad input exits with status 1 and `error: …` naming the value (clap's own
 //! parse errors exit with status 2).
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use geosens::rod::figures::{self, FigureOptions};
 use geosens::rod::{Direction, Method as McMethod, Probe, Rod, exact};
 use geosens::{Error, Estimate, Quantity, RunConfig, RunResult, run};
 use serde::Serialize;
-use std::io::{self, Write};
+use std::io::{self, IsTerminal, Write};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -35,8 +36,9 @@ struct Cli {
 enum Command {
     /// Estimate I, ∂I/∂length (and ∂I/∂x) at one probe on a rod.
     Rod(RodArgs),
-    /// Compare the four methods with the exact solution on the paper's rods.
-    Compare(RunArgs),
+    /// Compare the four methods with the exact solution on the paper's rods,
+    /// then write the rod's figures.
+    Compare(CompareArgs),
 }
 
 /// How to estimate: the method, the rod, the probe and the run. Float values
@@ -69,6 +71,23 @@ struct RodArgs {
     /// Print one JSON line instead of a table.
     #[arg(long)]
     json: bool,
+}
+
+/// `geosens compare`: the table's run, and where the figures go.
+#[derive(Debug, Args)]
+struct CompareArgs {
+    /// The table's run configuration (the figures use the seed and threads).
+    #[command(flatten)]
+    run: RunArgs,
+    /// Folder the figures (PNG, SVG and the JSON of their numbers) go to.
+    #[arg(long, default_value = "out/figures")]
+    figures: std::path::PathBuf,
+    /// Multiplies the figures' path counts (1 = the book's figures).
+    #[arg(long, default_value_t = 1.0)]
+    effort: f64,
+    /// Print the table only.
+    #[arg(long)]
+    no_figures: bool,
 }
 
 /// Run configuration, shared by both subcommands.
@@ -330,8 +349,20 @@ fn row(label: &str, r: &RunResult, exact: &[f64; 3]) -> String {
 }
 
 /// `geosens compare`.
-fn compare_command(args: &RunArgs, out: &mut impl Write) -> Result<(), Box<dyn std::error::Error>> {
-    let cfg = args.config(200_000)?;
+fn compare_command(
+    args: &CompareArgs,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let effort = args.effort;
+    if !(effort.is_finite() && effort > 0.0) {
+        return Err(Error::InvalidParameter {
+            name: "effort",
+            value: effort,
+            expected: "a finite number > 0",
+        }
+        .into());
+    }
+    let cfg = args.run.config(200_000)?;
     let start = Instant::now();
     // Per method: total sampling time, largest z-score, unreliable estimates.
     let mut totals = [(0.0, 0.0f64, 0usize); 4];
@@ -384,6 +415,23 @@ fn compare_command(args: &RunArgs, out: &mut impl Write) -> Result<(), Box<dyn s
         "total wall time {:.2} s",
         start.elapsed().as_secs_f64()
     )?;
+    if !args.no_figures {
+        out.flush()?;
+        let mut opts = FigureOptions::new(&args.figures);
+        opts.seed = cfg.seed;
+        opts.threads = cfg.threads;
+        opts.effort = effort;
+        opts.progress = io::stderr().is_terminal();
+        let start = Instant::now();
+        let written = figures::all(&opts)?;
+        writeln!(
+            out,
+            "\nwrote {} files to {} in {:.1} s",
+            written.len(),
+            args.figures.display(),
+            start.elapsed().as_secs_f64()
+        )?;
+    }
     Ok(())
 }
 

@@ -91,6 +91,24 @@ impl FigureOptions {
     }
 }
 
+/// A figure: runs its experiment and writes its files.
+pub type FigureFn = fn(&FigureOptions) -> Result<Vec<PathBuf>, Error>;
+
+/// Every figure of the rod, in the book's order; returns the files written.
+pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
+    let figures: [FigureFn; 4] = [
+        along::intensity_along_rod,
+        along::sensitivity_along_rod,
+        convergence::convergence,
+        efficiency::efficiency,
+    ];
+    let mut written = Vec::new();
+    for figure in figures {
+        written.extend(figure(opts)?);
+    }
+    Ok(written)
+}
+
 /// The paper's optically thin rod: κs = 0.07, κe = 0.1, length 2.
 pub fn thin() -> Rod {
     Rod {
