@@ -32,14 +32,6 @@ pub fn exact_value(rod: &Rod, x: f64, omega: Direction, q: &Quantity) -> f64 {
     exact::solve(rod, x, omega).get(q)
 }
 
-/// `(quantity, z-score against the exact solution)` for every estimate of `r`.
-pub fn z_scores(r: &RunResult, rod: &Rod, x: f64, omega: Direction) -> Vec<(Quantity, f64)> {
-    r.estimates
-        .iter()
-        .map(|(q, e)| (q.clone(), e.z_score(exact_value(rod, x, omega, q))))
-        .collect()
-}
-
 /// Asserts every estimate of `method` is within `k` standard errors of exact.
 pub fn assert_within(
     method: Method,
