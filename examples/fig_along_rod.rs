@@ -9,18 +9,9 @@
 use geosens::rod::figures::{FigureOptions, along};
 
 fn main() -> Result<(), geosens::Error> {
-    let mut args = std::env::args().skip(1);
-    let mut opts = FigureOptions::new(args.next().unwrap_or_else(|| "out/figures".into()));
-    if let Some(e) = args.next() {
-        opts.effort = e
-            .parse()
-            .map_err(|_| geosens::Error::Output(format!("bad effort {e:?}")))?;
-    }
-    for path in along::intensity_along_rod(&opts)?
-        .into_iter()
-        .chain(along::sensitivity_along_rod(&opts)?)
-    {
-        println!("wrote {}", path.display());
-    }
-    Ok(())
+    FigureOptions::run_example(|opts| {
+        let mut written = along::intensity_along_rod(opts)?;
+        written.extend(along::sensitivity_along_rod(opts)?);
+        Ok(written)
+    })
 }

@@ -10,15 +10,5 @@
 use geosens::rod::figures::{FigureOptions, efficiency};
 
 fn main() -> Result<(), geosens::Error> {
-    let mut args = std::env::args().skip(1);
-    let mut opts = FigureOptions::new(args.next().unwrap_or_else(|| "out/figures".into()));
-    if let Some(e) = args.next() {
-        opts.effort = e
-            .parse()
-            .map_err(|_| geosens::Error::Output(format!("bad effort {e:?}")))?;
-    }
-    for path in efficiency::efficiency(&opts)? {
-        println!("wrote {}", path.display());
-    }
-    Ok(())
+    FigureOptions::run_example(efficiency::efficiency)
 }

@@ -43,6 +43,25 @@ impl FigureOptions {
         }
     }
 
+    /// Options from an example's command line, `[OUT_DIR] [EFFORT]` (defaults
+    /// `out/figures` and 1), and a runner that prints the files `figure`
+    /// writes: what every `examples/fig_*.rs` does.
+    pub fn run_example(figure: FigureFn) -> Result<(), Error> {
+        let mut args = std::env::args().skip(1);
+        let mut opts = FigureOptions::new(args.next().unwrap_or_else(|| "out/figures".into()));
+        if let Some(e) = args.next() {
+            opts.effort = e
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| Error::Output(format!("bad effort {e:?}: expected a number > 0")))?;
+        }
+        for path in figure(&opts)? {
+            println!("wrote {}", path.display());
+        }
+        Ok(())
+    }
+
     /// `paths` scaled by the effort, at least 2.
     pub fn paths(&self, paths: u64) -> u64 {
         ((paths as f64 * self.effort).round() as u64).max(2)
