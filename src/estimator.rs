@@ -8,6 +8,7 @@
 //! loop allocates nothing. The [`runner`](crate::runner) turns the weights
 //! into estimates.
 use crate::rng::PathRng;
+use crate::stats::ChunkSums;
 use serde::Serialize;
 use std::fmt;
 
@@ -59,4 +60,20 @@ pub trait Estimator: Sync {
     /// Samples one path (or path pair) and writes one weight per quantity
     /// into `weights` (of length `self.quantities().len()`).
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]);
+
+    /// Samples `paths` paths and adds their weights to `sums` (one
+    /// accumulator per quantity). This provided loop is compiled once per
+    /// estimator, so even through `dyn Estimator` the runner pays one
+    /// dynamic call per chunk and `sample` is called statically (and
+    /// inlined); estimators need not override it.
+    #[inline]
+    fn accumulate(&self, rng: &mut PathRng, paths: u64, sums: &mut [ChunkSums]) {
+        let mut w = vec![0.0; sums.len()];
+        for _ in 0..paths {
+            self.sample(rng, &mut w);
+            for (s, &x) in sums.iter_mut().zip(&w) {
+                s.push(x);
+            }
+        }
+    }
 }

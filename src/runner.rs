@@ -75,13 +75,7 @@ fn run_chunk<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig, nq: usize, c: u64)
     let mut rng = rng::stream(cfg.seed, c);
     let len = CHUNK.min(cfg.paths - c * CHUNK);
     let mut sums = vec![ChunkSums::default(); nq];
-    let mut w = vec![0.0; nq];
-    for _ in 0..len {
-        est.sample(&mut rng, &mut w);
-        for (s, &x) in sums.iter_mut().zip(&w) {
-            s.push(x);
-        }
-    }
+    est.accumulate(&mut rng, len, &mut sums);
     sums.iter().map(ChunkSums::moments).collect()
 }
 
@@ -97,17 +91,33 @@ pub fn run<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig) -> Result<RunResult,
     let quantities = est.quantities();
     let nq = quantities.len();
     let chunks = cfg.paths.div_ceil(CHUNK);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(cfg.threads)
-        .build()
-        .map_err(|e| Error::Config(format!("cannot start {} threads: {e}", cfg.threads)))?;
-    let start = Instant::now();
-    let per_chunk: Vec<Vec<Moments>> = pool.install(|| {
-        (0..chunks)
+    let per_chunk: Vec<Vec<Moments>>;
+    let start;
+    if cfg.threads == 1 {
+        // One thread: no pool to build (a thread spawn per call), same chunks
+        // in the same order, so the same bits.
+        start = Instant::now();
+        per_chunk = (0..chunks).map(|c| run_chunk(est, cfg, nq, c)).collect();
+    } else if cfg.threads == 0 {
+        // All cores: rayon's global pool, built once per process.
+        start = Instant::now();
+        per_chunk = (0..chunks)
             .into_par_iter()
             .map(|c| run_chunk(est, cfg, nq, c))
-            .collect()
-    });
+            .collect();
+    } else {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(cfg.threads)
+            .build()
+            .map_err(|e| Error::Config(format!("cannot start {} threads: {e}", cfg.threads)))?;
+        start = Instant::now();
+        per_chunk = pool.install(|| {
+            (0..chunks)
+                .into_par_iter()
+                .map(|c| run_chunk(est, cfg, nq, c))
+                .collect()
+        });
+    }
     let mut total = vec![Moments::default(); nq];
     for chunk in &per_chunk {
         for (t, m) in total.iter_mut().zip(chunk) {

@@ -75,8 +75,13 @@ pub fn solve<const N: usize>(
     source: impl FnOnce(Side, &mut PathRng) -> [f64; N],
 ) -> [f64; N] {
     let exit = walk(rod, x, dir, rng, &mut ());
+    let s = source(exit.side, rng);
+    if s.iter().all(|&v| v == 0.0) {
+        // Nothing to attenuate: skip the exponential (a · ±0 = ±0 anyway).
+        return s;
+    }
     let a = attenuation(rod, exit.length);
-    source(exit.side, rng).map(|s| a * s)
+    s.map(|v| a * v)
 }
 // ANCHOR_END: solve
 

@@ -66,13 +66,16 @@ pub fn walk<E: Events>(
     rng: &mut PathRng,
     events: &mut E,
 ) -> Exit {
+    // The generator's state in registers for the whole walk, written back
+    // once: through `&mut` it is stored to memory at every draw.
+    let mut local = rng.clone();
     let mut length = 0.0;
-    loop {
+    let exit = loop {
         let d = rod.distance_to_boundary(x, dir);
-        let xi = free_path(rod.ks, rng);
+        let xi = free_path(rod.ks, &mut local);
         if xi >= d {
             events.escape(dir, d);
-            return Exit {
+            break Exit {
                 side: dir.end(),
                 length: length + d,
             };
@@ -80,8 +83,10 @@ pub fn walk<E: Events>(
         events.collision(dir, xi, d);
         length += xi;
         x += dir.sign() * xi;
-        dir = scatter_direction(rng);
-    }
+        dir = scatter_direction(&mut local);
+    };
+    *rng = local;
+    exit
 }
 // ANCHOR_END: walk
 
