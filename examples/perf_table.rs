@@ -1,4 +1,5 @@
-//! Wall-clock cost of each rod method, the paper's Table 1 redone: the time
+//! Wall-clock cost of each rod method, the paper's Table 1 redone (printed
+//! beside the paper's times and ratios): the time
 //! of `run(...)` on one thread for N = 10⁶ paths at x = 1, thin and thick
 //! rods, both directions, as ratios to the intensity method and to a
 //! hand-written Algorithm 3 loop (`benches/support/baseline.rs`).
@@ -33,6 +34,21 @@ const SEED: u64 = 1;
 const X: f64 = 1.0;
 const LENGTH: f64 = 2.0;
 const RODS: [(&str, f64, f64); 2] = [("thin", 0.07, 0.1), ("thick", 2.1, 3.0)];
+
+/// The paper's Table 1 (He et al. 2024), N = 10⁶, ms: intensity (Alg. 3),
+/// rendering (Alg. 5), expectation (Alg. 4), by rod name.
+fn paper_ms(rod: &str, row: Row) -> Option<f64> {
+    let (intensity, rendering, expectation) = match rod {
+        "thin" => (72.0, 126.0, 136.0),
+        _ => (142.0, 287.0, 297.0),
+    };
+    match row {
+        Row::Method(Method::Intensity) => Some(intensity),
+        Row::Method(Method::Rendering) => Some(rendering),
+        Row::Method(Method::Expectation) => Some(expectation),
+        _ => None,
+    }
+}
 
 /// What one row of the table runs.
 #[derive(Clone, Copy)]
@@ -148,8 +164,8 @@ fn table(rounds: usize) -> Result<(), Error> {
                 omega.sign()
             );
             println!(
-                "  {:<12} {:>9} {:>9} {:>8} {:>8}   estimates",
-                "method", "ms", "Mpaths/s", "/intens", "/base"
+                "  {:<12} {:>9} {:>9} {:>8} {:>8} {:>15}   estimates",
+                "method", "ms", "Mpaths/s", "/intens", "/base", "paper ms (/int)"
             );
             // times[round][row]
             let mut times = Vec::with_capacity(rounds);
@@ -172,13 +188,21 @@ fn table(rounds: usize) -> Result<(), Error> {
                 let t = median(times.iter().map(|t| t[k]).collect());
                 let per_intensity = median(times.iter().map(|t| t[k] / t[1]).collect());
                 let per_baseline = median(times.iter().map(|t| t[k] / t[0]).collect());
+                let paper = match paper_ms(name, row) {
+                    Some(ms) => {
+                        let base = paper_ms(name, Row::Method(Method::Intensity)).unwrap_or(ms);
+                        format!("{ms:.0} ({:.2})", ms / base)
+                    }
+                    None => "-".into(),
+                };
                 println!(
-                    "  {:<12} {:>9.1} {:>9.2} {:>8.2} {:>8.2}   {}",
+                    "  {:<12} {:>9.1} {:>9.2} {:>8.2} {:>8.2} {:>15}   {}",
                     row.name(),
                     t * 1e3,
                     n as f64 / t / 1e6,
                     per_intensity,
                     per_baseline,
+                    paper,
                     estimates[k]
                 );
             }
