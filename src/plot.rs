@@ -93,6 +93,9 @@ pub struct Panel {
     pub heat: Option<HeatMap>,
     /// Where the legend goes.
     pub legend: Legend,
+    /// Names for the integer x ticks `0, 1, …` (categorical axes, e.g. heat
+    /// map cells centred on integers); empty for numeric ticks.
+    pub x_tick_names: Vec<String>,
 }
 
 /// Legend placement inside a panel.
@@ -207,7 +210,14 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
         .y_label_area_size(70)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(plot_err)?;
-    let fmt_x = |v: &f64| tick(*v, p.x_log);
+    let fmt_x = |v: &f64| {
+        if p.x_tick_names.is_empty() {
+            return tick(*v, p.x_log);
+        }
+        let i = v.round();
+        let name = (i >= 0.0 && (v - i).abs() < 1e-9).then(|| p.x_tick_names.get(i as usize));
+        name.flatten().cloned().unwrap_or_default()
+    };
     let fmt_y = |v: &f64| tick(*v, p.y_log);
     chart
         .configure_mesh()

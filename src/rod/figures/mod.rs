@@ -14,6 +14,7 @@ use std::path::PathBuf;
 pub mod along;
 pub mod convergence;
 pub mod efficiency;
+pub mod stability;
 
 /// What every figure function takes.
 #[derive(Debug, Clone)]
@@ -115,11 +116,12 @@ pub type FigureFn = fn(&FigureOptions) -> Result<Vec<PathBuf>, Error>;
 
 /// Every figure of the rod, in the book's order; returns the files written.
 pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let figures: [FigureFn; 4] = [
+    let figures: [FigureFn; 5] = [
         along::intensity_along_rod,
         along::sensitivity_along_rod,
         convergence::convergence,
         efficiency::efficiency,
+        stability::stability,
     ];
     let mut written = Vec::new();
     for figure in figures {
