@@ -40,6 +40,7 @@
 
 pub mod error;
 pub mod estimator;
+pub mod fd;
 pub mod plot;
 pub mod rng;
 pub mod rod;

@@ -14,6 +14,7 @@ use std::path::PathBuf;
 pub mod along;
 pub mod convergence;
 pub mod efficiency;
+pub mod finite_difference;
 pub mod stability;
 
 /// What every figure function takes.
@@ -116,7 +117,8 @@ pub type FigureFn = fn(&FigureOptions) -> Result<Vec<PathBuf>, Error>;
 
 /// Every figure of the rod, in the book's order; returns the files written.
 pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let figures: [FigureFn; 5] = [
+    let figures: [FigureFn; 6] = [
+        finite_difference::finite_difference,
         along::intensity_along_rod,
         along::sensitivity_along_rod,
         convergence::convergence,
