@@ -12,7 +12,8 @@
 //!
 //! Neither can see what was never sampled: a weight of huge size and tiny
 //! probability that no path hit leaves a small, wrong error bar and clean
-//! diagnostics (the book's stability chapter shows where this happens).
+//! diagnostics (the stability map of the book's chapter "Comparing the
+//! approaches" shows where this happens).
 use serde::Serialize;
 
 /// Hot-loop accumulator over one chunk: power sums of the weights shifted by

@@ -1,5 +1,6 @@
 //! Backward path tracing of the intensity (Algorithm 3, Eq. 28): a path from
 //! the probe travelling along `−ω` collects `Î e^{−κa L}` where it leaves.
+//! Book: chapter "Backward path tracing of the intensity".
 use super::walk::intensity_weight;
 use super::{Probe, Rod};
 use crate::estimator::{Estimator, Quantity};

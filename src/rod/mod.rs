@@ -7,7 +7,8 @@
 //!
 //! A rod needs a float and a sign, so positions are `f64` and directions are
 //! [`Direction`]. The estimators live in one module each, the exact solution in
-//! [`exact`], the shared random walk in [`walk`]. Book: chapter "The rod".
+//! [`exact`], the shared random walk in [`walk`]. Book: chapter "The rod and its
+//! exact solution".
 use crate::error::{Error, check};
 use crate::estimator::Estimator;
 

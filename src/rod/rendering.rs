@@ -7,6 +7,7 @@
 //! `(κs/2) e^{−κa L} Ŵ(π̃, +1)`.
 //!
 //! The primary path is an intensity path too, so `I` comes for free.
+//! Book: chapter "Differentiable rendering".
 use super::walk::{score, walk};
 use super::{Direction, PARAMETER, Probe, Rod, Side};
 use crate::estimator::{Estimator, Quantity};

@@ -17,6 +17,7 @@
 //! derivative `s + ∂xI` vanishes there (Appendix E; the paper's Eq. 43 prints
 //! the opposite sign, which the exact solution refutes). Sources that need an
 //! unknown intensity draw one nested intensity path (double randomization).
+//! Book: chapter "The sensitivity transport model".
 use super::walk::{attenuation, walk};
 use super::{Direction, PARAMETER, Probe, Rod, Side};
 use crate::estimator::{Estimator, Quantity};

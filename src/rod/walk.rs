@@ -6,7 +6,8 @@
 //!
 //! Estimators that need more than the exit (the expectation method's
 //! domain-deformation velocity) observe every event through [`Events`]; the
-//! unit observer `()` compiles away.
+//! unit observer `()` compiles away. Book: chapter "Backward path tracing of
+//! the intensity".
 use super::{Direction, Rod, Side};
 use crate::rng::PathRng;
 use rand::Rng;
