@@ -7,7 +7,9 @@
 //! (VOV ≥ 0.1). The book discusses it in "Comparing the approaches"; the
 //! failure modes it shows are asserted in `tests/coverage.rs`.
 //!
-//! Transport's sensitivity weight is rendering's on the rod (same boundary
+//! Without scattering (`λ = 0`) nothing depends on the length: `s = 0` and
+//! every method returns exactly 0 (`tests/rod_estimators.rs`), so the map
+//! starts at `λ = 0.1`. Transport's sensitivity weight is rendering's on the rod (same boundary
 //! source, same nested path), so the map shows expectation and rendering.
 use super::FigureOptions;
 use crate::error::Error;
@@ -24,7 +26,7 @@ pub const POSITIONS: [f64; 9] = [0.0, 0.25, 0.5, 0.75, 0.9, 0.97, 0.99, 0.999, 1
 /// Optical thicknesses `κe π̃`.
 pub const THICKNESSES: [f64; 6] = [0.1, 0.3, 1.0, 3.0, 10.0, 30.0];
 /// Albedos `λ = κs/κe`.
-pub const ALBEDOS: [f64; 3] = [0.5, 0.9, 1.0];
+pub const ALBEDOS: [f64; 4] = [0.1, 0.5, 0.9, 1.0];
 /// Independent runs per cell.
 pub const RUNS: u64 = 100;
 /// Paths per run (times the effort).
