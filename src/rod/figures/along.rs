@@ -3,8 +3,9 @@
 use super::{FigureOptions, exact_value, positions, thick, thin};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::plot::{Figure, Legend, Panel, Series};
+use crate::plot::{Figure, Legend, Mark, Panel, Series};
 use crate::rod::{Direction, Method, PARAMETER, Rod};
+use serde::Serialize;
 use std::path::PathBuf;
 
 /// Paths per point of the along-the-rod figures (times the effort).
@@ -74,6 +75,42 @@ fn panel(
     })
 }
 
+/// `(x, mean, σ)` of one point.
+type Estimated = (f64, f64, f64);
+
+/// The estimates behind one panel: its title and `(x, mean, σ)` per series.
+#[derive(Debug, Serialize)]
+struct PanelNumbers<'a> {
+    title: &'a str,
+    series: Vec<(&'a str, &'a [Estimated])>,
+}
+
+/// Writes the figure (PNG, SVG) and the estimates it plots (JSON).
+fn save_with_numbers(
+    opts: &FigureOptions,
+    panels: Vec<Panel>,
+    name: &str,
+) -> Result<Vec<PathBuf>, Error> {
+    let numbers: Vec<PanelNumbers> = panels
+        .iter()
+        .map(|p| PanelNumbers {
+            title: &p.title,
+            series: p
+                .series
+                .iter()
+                .filter_map(|s| match &s.mark {
+                    Mark::Points(v) => Some((s.label.as_str(), v.as_slice())),
+                    _ => None,
+                })
+                .collect(),
+        })
+        .collect();
+    let json = opts.write_json(name, &numbers)?;
+    let mut written = Figure::new(panels, 2).save(&opts.out, name)?;
+    written.push(json);
+    Ok(written)
+}
+
 /// Fig. 5: right- and left-going intensity against x with ±σ error bars,
 /// thin and thick rods. Writes `intensity_along_rod.{png,svg}`.
 pub fn intensity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
@@ -94,7 +131,7 @@ pub fn intensity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> 
         bar.inc(1);
     }
     bar.finish();
-    Figure::new(panels, 2).save(&opts.out, "intensity_along_rod")
+    save_with_numbers(opts, panels, "intensity_along_rod")
 }
 
 /// Fig. 6a–d: s against x for rendering, expectation and transport, and
@@ -122,5 +159,5 @@ pub fn sensitivity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error
         }
     }
     bar.finish();
-    Figure::new(panels, 2).save(&opts.out, "sensitivity_along_rod")
+    save_with_numbers(opts, panels, "sensitivity_along_rod")
 }
