@@ -156,6 +156,7 @@ fn one(args: &[String]) -> Result<(), Error> {
 fn table(rounds: usize) -> Result<(), Error> {
     let n = 1_000_000;
     println!("N = {n} paths, x = {X}, 1 thread, seed {SEED}, {rounds} rounds");
+    let bar = progress((RODS.len() * 2 * rounds) as u64, "Table 1 rounds");
     for (name, ks, ke) in RODS {
         let rod = Rod::new(ks, ke, LENGTH)?;
         for omega in [Direction::Left, Direction::Right] {
@@ -171,6 +172,7 @@ fn table(rounds: usize) -> Result<(), Error> {
             let mut times = Vec::with_capacity(rounds);
             let mut estimates: Vec<String> = Vec::new();
             for round in 0..rounds {
+                bar.inc(1);
                 let mut t = Vec::with_capacity(Row::ALL.len());
                 for (k, row) in Row::ALL.into_iter().enumerate() {
                     let (s, e) = timed(|| row.run(&rod, omega, n, 1));
@@ -209,6 +211,16 @@ fn table(rounds: usize) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// A progress bar on standard error (indicatif hides it off a terminal),
+/// cleared before the table it belongs to is printed.
+fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len).with_message(what.to_owned());
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len}") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
 }
 
 fn speedup(rounds: usize) -> Result<(), Error> {
