@@ -221,10 +221,10 @@ mod tests {
             .map(Moments::of)
             .fold(Moments::default(), |a, b| a.merge(&b));
         assert_eq!(merged.n, 1000);
-        assert!((merged.mean - mean).abs() < 1e-12 * mean.abs());
-        assert!((merged.m2 - m2).abs() < 1e-9 * m2);
+        approx::assert_relative_eq!(merged.mean, mean, max_relative = 1e-12);
+        approx::assert_relative_eq!(merged.m2, m2, max_relative = 1e-9);
         assert!((merged.m3 - m3).abs() < 1e-7 * m4.sqrt() * m2.sqrt());
-        assert!((merged.m4 - m4).abs() < 1e-9 * m4);
+        approx::assert_relative_eq!(merged.m4, m4, max_relative = 1e-9);
     }
 
     #[test]
