@@ -1,12 +1,13 @@
-//! Stability map: where each method's error bar cannot be trusted, over the
-//! probe position, the optical thickness and the albedo.
+//! Stability map (the book's "Comparing the approaches"): the coverage of
+//! every method's error bar on `s`, and where the tail diagnostic flags it,
+//! over the probe position, the optical thickness, the albedo and both
+//! directions.
 //!
 //! ```text
 //! cargo run --release --example fig_stability -- [OUT_DIR] [EFFORT]
 //! ```
-//! writes `stability.{png,svg}`, `stability_flagged.{png,svg}` and
-//! `stability.json` to `OUT_DIR` (default `out/figures`); `EFFORT` scales the
-//! path counts.
+//! writes `stability.{png,svg}` and `stability.json` (every cell's numbers)
+//! to `OUT_DIR` (default `out/figures`); `EFFORT` scales the path counts.
 use geosens::rod::figures::{FigureOptions, stability};
 
 fn main() -> Result<(), geosens::Error> {

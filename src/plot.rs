@@ -96,6 +96,8 @@ pub struct Panel {
     /// Names for the integer x ticks `0, 1, …` (categorical axes, e.g. heat
     /// map cells centred on integers); empty for numeric ticks.
     pub x_tick_names: Vec<String>,
+    /// Names for the integer y ticks, as `x_tick_names`.
+    pub y_tick_names: Vec<String>,
 }
 
 /// Legend placement inside a panel.
@@ -210,21 +212,16 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
         .y_label_area_size(70)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(plot_err)?;
-    let fmt_x = |v: &f64| {
-        if p.x_tick_names.is_empty() {
-            return tick(*v, p.x_log);
-        }
-        let i = v.round();
-        let name = (i >= 0.0 && (v - i).abs() < 1e-9).then(|| p.x_tick_names.get(i as usize));
-        name.flatten().cloned().unwrap_or_default()
-    };
-    let fmt_y = |v: &f64| tick(*v, p.y_log);
+    let fmt_x = |v: &f64| named_tick(*v, p.x_log, &p.x_tick_names);
+    let fmt_y = |v: &f64| named_tick(*v, p.y_log, &p.y_tick_names);
     chart
         .configure_mesh()
         .x_desc(p.x_label.as_str())
         .y_desc(p.y_label.as_str())
         .x_label_formatter(&fmt_x)
         .y_label_formatter(&fmt_y)
+        .x_labels(label_count(&p.x_tick_names))
+        .y_labels(label_count(&p.y_tick_names))
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(plot_err)?;
@@ -298,6 +295,52 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
             .map_err(plot_err)?;
     }
     Ok(())
+}
+
+/// Tick label on an axis with `names` for its integer ticks (categorical),
+/// or the value if `names` is empty.
+fn named_tick(v: f64, log: bool, names: &[String]) -> String {
+    if names.is_empty() {
+        return tick(v, log);
+    }
+    let i = v.round();
+    let name = (i >= 0.0 && (v - i).abs() < 1e-9).then(|| names.get(i as usize));
+    name.flatten().cloned().unwrap_or_default()
+}
+
+/// How many tick labels an axis asks for: every name of a categorical axis
+/// (plotters then puts one at each integer), plotters' default of 10 else.
+fn label_count(names: &[String]) -> usize {
+    if names.is_empty() { 10 } else { names.len() }
+}
+
+/// A colour legend for heat maps: a panel whose heat map is a horizontal
+/// strip of the colours that a heat map with `range` (as [`HeatMap::range`];
+/// it may decrease) gives the values `span.0..span.1`, with the values on the
+/// x axis labelled `label`. The strip fills the lower third of the chart; the
+/// room above is for the legend of any series the caller adds (markers drawn
+/// over the heat maps, say).
+pub fn colour_bar(title: &str, label: &str, range: (f64, f64), span: (f64, f64)) -> Panel {
+    const STEPS: usize = 200;
+    let (lo, hi) = (span.0.min(span.1), span.0.max(span.1));
+    let x_edges: Vec<f64> = (0..=STEPS)
+        .map(|i| lo + (hi - lo) * i as f64 / STEPS as f64)
+        .collect();
+    let values = x_edges.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();
+    Panel {
+        title: title.into(),
+        x_label: label.into(),
+        // One invisible point lifts the y range above the strip.
+        series: vec![Series::line("", 0, vec![(lo, 2.5)])],
+        heat: Some(HeatMap {
+            x_edges,
+            y_edges: vec![-0.5, 0.5],
+            values,
+            range,
+        }),
+        y_tick_names: vec![String::new()],
+        ..Panel::default()
+    }
 }
 
 /// Tick label: the value, or `10^v` on a log axis.

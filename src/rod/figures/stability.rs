@@ -1,38 +1,87 @@
-//! Stability map: where each method's error bar cannot be trusted. Over the
-//! probe position `x/π̃` (denser near the moving end), the optical thickness
-//! `κe π̃` from 0.1 to 30 and the albedo `λ`, every cell runs `R` independent
-//! estimates of `s` with `N` paths each and records the measured coverage
-//! (the fraction of runs whose ±2σ bar misses the exact `s`; 4.6 % for an
-//! honest error bar) and the fraction the tail diagnostic flags
-//! (VOV ≥ 0.1). The book discusses it in "Comparing the approaches"; the
-//! failure modes it shows are asserted in `tests/coverage.rs`.
+//! Stability map (the book's chapter "Comparing the approaches"): where each
+//! method's error bar on `s` cannot be trusted.
 //!
-//! Without scattering (`λ = 0`) nothing depends on the length: `s = 0` and
-//! every method returns exactly 0 (`tests/rod_estimators.rs`), so the map
-//! starts at `λ = 0.1`. Transport's sensitivity weight is rendering's on the rod (same boundary
-//! source, same nested path), so the map shows expectation and rendering.
+//! Over the probe position `x/π̃` (a non-uniform grid closing in on the
+//! moving end), the optical thickness `κe π̃` from 0.1 to 30 (log grid) and
+//! the albedo `λ`, in both directions, every cell runs [`RUNS`] independent
+//! estimates of `s` with [`PATHS`] paths each (distinct seeds) by expectation
+//! differentiation, differentiable rendering and the transport model, and
+//! records
+//!
+//! - the measured coverage: the fraction of runs with `|mean − s| ≤ 2σ`
+//!   (0.954 for an honest error bar). The z-score needs no relative error,
+//!   so cells where `s` is tiny keep their meaning; a run reporting `0 ± 0`
+//!   counts as covered where `s = 0` and as a miss anywhere else;
+//! - the fraction of runs the tail diagnostic flags (`VOV ≥ 0.1`);
+//! - the fraction of runs reporting `σ = 0`: no path drew a non-zero weight,
+//!   and a VOV of 0 calls such a run reliable.
+//!
+//! The figure colours each cell by its coverage (white where honest, red
+//! where the error bar is too small), puts a black dot where most runs are
+//! flagged and a blue one where most runs report `σ = 0`, and greys the
+//! cells where `s = 0` exactly (`x = 0`, `ω = +1`, where every method
+//! returns `0 ± 0`). A red cell with a black dot is a failure the diagnostic
+//! sees; a red cell with a blue dot, one that no diagnostic can see.
+//!
+//! Without scattering (`λ = 0`) no path depends on the length: `s = 0`
+//! everywhere and every method returns exactly `0 ± 0`
+//! (`tests/rod_estimators.rs`). Nothing to map, so the albedos start at 0.1.
+//! The failure modes the map shows are pinned by `tests/coverage.rs`.
 use super::FigureOptions;
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::plot::{Figure, HeatMap, Panel};
+use crate::plot::{Figure, HeatMap, Panel, Series, colour_bar};
 use crate::rod::{Direction, Method, PARAMETER, Probe, Rod, exact};
 use crate::runner::{RunConfig, run};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
 
-/// Probe positions as fractions of the length, denser near the moving end.
-pub const POSITIONS: [f64; 9] = [0.0, 0.25, 0.5, 0.75, 0.9, 0.97, 0.99, 0.999, 1.0];
-/// Optical thicknesses `κe π̃`.
-pub const THICKNESSES: [f64; 6] = [0.1, 0.3, 1.0, 3.0, 10.0, 30.0];
+/// Probe positions as fractions of the length: both ends, and a non-uniform
+/// grid closing in on the moving end, where the expectation method's weight
+/// grows like `1/(π̃ − x)`.
+pub const POSITIONS: [f64; 13] = [
+    0.0, 0.1, 0.25, 0.5, 0.75, 0.9, 0.95, 0.98, 0.99, 0.995, 0.999, 0.9999, 1.0,
+];
+/// Number of optical thicknesses `κe π̃`, log-spaced over [`THICKNESS_RANGE`].
+pub const THICKNESS_COUNT: usize = 9;
+/// Smallest and largest optical thickness `κe π̃`.
+pub const THICKNESS_RANGE: (f64, f64) = (0.1, 30.0);
 /// Albedos `λ = κs/κe`.
 pub const ALBEDOS: [f64; 4] = [0.1, 0.5, 0.9, 1.0];
+/// The sensitivity methods mapped.
+pub const METHODS: [Method; 3] = [Method::Expectation, Method::Rendering, Method::Transport];
 /// Independent runs per cell.
 pub const RUNS: u64 = 100;
 /// Paths per run (times the effort).
 pub const PATHS: u64 = 4000;
+/// Coverage of `±2σ` for a normal estimate.
+pub const NOMINAL: f64 = 0.9545;
+/// `|s|` below which [`Cell::negligible`] marks a cell (`I0 = 1`, `π̃ = 2`):
+/// its coverage is still meaningful, but no error there matters.
+pub const NEGLIGIBLE: f64 = 1e-6;
 /// Rod length of every cell.
 const LENGTH: f64 = 2.0;
+
+/// The optical thicknesses `κe π̃`: [`THICKNESS_COUNT`] values log-spaced
+/// over [`THICKNESS_RANGE`].
+pub fn thicknesses() -> Vec<f64> {
+    let (lo, hi) = THICKNESS_RANGE;
+    let step = (hi / lo).ln() / (THICKNESS_COUNT - 1) as f64;
+    (0..THICKNESS_COUNT)
+        .map(|i| lo * (step * i as f64).exp())
+        .collect()
+}
+
+/// Where one cell is: method, direction, albedo, thickness, position.
+#[derive(Debug, Clone, Copy)]
+struct Site {
+    method: Method,
+    omega: Direction,
+    albedo: f64,
+    thickness: f64,
+    position: f64,
+}
 
 /// The measurements of one cell.
 #[derive(Debug, Clone, Serialize)]
@@ -49,161 +98,315 @@ pub struct Cell {
     pub position: f64,
     /// Exact `s`.
     pub exact: f64,
-    /// Fraction of runs whose ±2σ bar misses the exact value.
-    pub missed_2sigma: f64,
-    /// Fraction of runs whose ±3σ bar misses it.
-    pub missed_3sigma: f64,
+    /// `|s| <` [`NEGLIGIBLE`].
+    pub negligible: bool,
+    /// Fraction of runs with `|mean − s| ≤ 2σ` (ideal 0.954).
+    pub coverage_2sigma: f64,
+    /// Fraction of runs with `|mean − s| ≤ 3σ` (ideal 0.997).
+    pub coverage_3sigma: f64,
     /// Fraction of runs flagged unreliable by the VOV.
     pub flagged: f64,
+    /// Fraction of runs missing `±3σ` without being flagged: failures no
+    /// diagnostic sees.
+    pub silent_misses: f64,
+    /// Fraction of runs reporting `σ = 0` (no path carried a weight, or all
+    /// carried the same).
+    pub zero_stderr: f64,
+    /// Median over runs of `σ/|s|` (null where `s = 0`).
+    pub median_relative_stderr: f64,
     /// Paths per run.
     pub paths: u64,
     /// Runs.
     pub runs: u64,
 }
 
-/// Runs one cell: `RUNS` single-threaded runs with distinct seeds.
-fn measure(
-    opts: &FigureOptions,
-    method: Method,
-    omega: Direction,
-    albedo: f64,
-    thickness: f64,
-    position: f64,
-    salt: u64,
-) -> Result<Cell, Error> {
-    let ke = thickness / LENGTH;
-    let rod = Rod::new(albedo * ke, ke, LENGTH)?;
-    let x = position * LENGTH;
-    let probe = Probe::new(&rod, x, omega)?;
-    let reference = exact::solve(&rod, x, omega).sensitivity;
-    let estimator = method.estimator(rod, probe);
+/// Runs one cell: [`RUNS`] single-threaded runs with seeds
+/// `seed + salt·RUNS + r`.
+fn measure(opts: &FigureOptions, site: Site, salt: u64) -> Result<Cell, Error> {
+    let ke = site.thickness / LENGTH;
+    let rod = Rod::new(site.albedo * ke, ke, LENGTH)?;
+    let x = site.position * LENGTH;
+    let probe = Probe::new(&rod, x, site.omega)?;
+    let reference = exact::solve(&rod, x, site.omega).sensitivity;
+    let estimator = site.method.estimator(rod, probe);
     let q = Quantity::sensitivity(PARAMETER);
     let paths = opts.paths(PATHS);
-    let (mut miss2, mut miss3, mut flagged) = (0u64, 0u64, 0u64);
+    let (mut within2, mut within3, mut flagged, mut silent, mut zero) = (0, 0, 0, 0, 0);
+    let mut relative = Vec::with_capacity(RUNS as usize);
     for r in 0..RUNS {
         let seed = opts.seed.wrapping_add(salt * RUNS + r);
         let cfg = RunConfig::new(paths, seed)?.threads(1);
         let e = run(estimator.as_ref(), &cfg)?
             .get(&q)
-            .ok_or_else(|| Error::Output(format!("{} has no sensitivity", method.name())))?;
+            .ok_or_else(|| Error::Output(format!("{} has no sensitivity", site.method.name())))?;
         let z = e.z_score(reference);
-        miss2 += u64::from(z > 2.0);
-        miss3 += u64::from(z > 3.0);
-        flagged += u64::from(!e.is_reliable());
+        within2 += u32::from(z <= 2.0);
+        within3 += u32::from(z <= 3.0);
+        flagged += u32::from(!e.is_reliable());
+        silent += u32::from(z > 3.0 && e.is_reliable());
+        zero += u32::from(e.stderr == 0.0);
+        relative.push(e.stderr / reference.abs());
     }
-    let n = RUNS as f64;
+    relative.sort_by(f64::total_cmp);
+    let share = |k: u32| f64::from(k) / RUNS as f64;
     Ok(Cell {
-        method: method.name(),
-        omega: omega.sign(),
-        albedo,
-        thickness,
-        position,
+        method: site.method.name(),
+        omega: site.omega.sign(),
+        albedo: site.albedo,
+        thickness: site.thickness,
+        position: site.position,
         exact: reference,
-        missed_2sigma: miss2 as f64 / n,
-        missed_3sigma: miss3 as f64 / n,
-        flagged: flagged as f64 / n,
+        negligible: reference.abs() < NEGLIGIBLE,
+        coverage_2sigma: share(within2),
+        coverage_3sigma: share(within3),
+        flagged: share(flagged),
+        silent_misses: share(silent),
+        zero_stderr: share(zero),
+        median_relative_stderr: relative[relative.len() / 2],
         paths,
         runs: RUNS,
     })
 }
 
-/// The panels' row order: (method, direction).
-const ROWS: [(Method, Direction); 4] = [
-    (Method::Expectation, Direction::Left),
-    (Method::Expectation, Direction::Right),
-    (Method::Rendering, Direction::Left),
-    (Method::Rendering, Direction::Right),
-];
+/// Every cell of the map, in (method, direction, albedo, thickness,
+/// position) order.
+fn sites() -> Vec<Site> {
+    let thicknesses = thicknesses();
+    let mut sites = Vec::new();
+    for method in METHODS {
+        for omega in [Direction::Left, Direction::Right] {
+            for &albedo in &ALBEDOS {
+                for &thickness in &thicknesses {
+                    for &position in &POSITIONS {
+                        sites.push(Site {
+                            method,
+                            omega,
+                            albedo,
+                            thickness,
+                            position,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    sites
+}
 
-/// One heat map of `value` over (position, thickness) for a (row, albedo).
-fn panel(
-    cells: &[Cell],
-    (method, omega): (Method, Direction),
-    albedo: f64,
-    what: &str,
-    value: fn(&Cell) -> f64,
-) -> Panel {
-    let values = THICKNESSES
+/// Measures every cell on `opts.threads` threads (cells in parallel, each
+/// cell's runs on one thread).
+pub fn measure_all(opts: &FigureOptions) -> Result<Vec<Cell>, Error> {
+    let sites = sites();
+    let bar = opts.bar(sites.len() as u64, "stability map");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .map_err(|e| Error::Config(format!("cannot start {} threads: {e}", opts.threads)))?;
+    let cells = pool.install(|| {
+        sites
+            .par_iter()
+            .enumerate()
+            .map(|(i, &site)| {
+                let cell = measure(opts, site, i as u64);
+                bar.inc(1);
+                cell
+            })
+            .collect::<Result<Vec<_>, _>>()
+    })?;
+    bar.finish();
+    Ok(cells)
+}
+
+/// Everything `stability.json` holds: the grid and every cell.
+#[derive(Debug, Clone, Serialize)]
+pub struct Record {
+    /// Probe positions `x/π̃`.
+    pub positions: Vec<f64>,
+    /// Optical thicknesses `κe π̃`.
+    pub thicknesses: Vec<f64>,
+    /// Albedos.
+    pub albedos: Vec<f64>,
+    /// Rod length `π̃` of every cell.
+    pub length: f64,
+    /// Runs per cell.
+    pub runs: u64,
+    /// Paths per run.
+    pub paths: u64,
+    /// Every cell.
+    pub cells: Vec<Cell>,
+}
+
+/// Short names of the positions for the x ticks (`.999` for 0.999).
+fn position_names() -> Vec<String> {
+    POSITIONS
         .iter()
-        .flat_map(|&t| POSITIONS.iter().map(move |&p| (t, p)))
-        .map(|(t, p)| {
-            cells
-                .iter()
-                .find(|c| {
-                    c.method == method.name()
-                        && c.omega == omega.sign()
-                        && c.albedo == albedo
-                        && c.thickness == t
-                        && c.position == p
-                })
-                .map_or(f64::NAN, value)
+        .map(|&p| {
+            let s = format!("{p}");
+            s.strip_prefix("0.").map_or(s.clone(), |t| format!(".{t}"))
+        })
+        .collect()
+}
+
+/// Two significant digits: `0.42`, `7.2`, `15`.
+fn two_digits(v: f64) -> String {
+    let decimals = (1.0 - v.log10().floor()).max(0.0) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// The colour range of the coverage: white at [`NOMINAL`], red at 0.4 below,
+/// faint blue above (over-coverage is at most 0.046).
+const COVERAGE_RANGE: (f64, f64) = (NOMINAL + 0.4, NOMINAL - 0.4);
+/// Palette index of the "most runs flagged" marker (black).
+const FLAGGED_COLOR: usize = 6;
+/// Palette index of the "most runs report σ = 0" marker (sky blue).
+const ZERO_COLOR: usize = 5;
+
+/// One heat map of the 2σ coverage over (position, thickness) for one
+/// (method, direction, albedo), with markers where most runs are flagged or
+/// report `σ = 0`; grey where `s = 0`.
+fn panel(cells: &[&Cell], thicknesses: &[f64], title: String) -> Panel {
+    let at = |ix: usize, iy: usize| {
+        cells
+            .iter()
+            .find(|c| c.position == POSITIONS[ix] && c.thickness == thicknesses[iy])
+    };
+    let grid =
+        || (0..thicknesses.len()).flat_map(|iy| (0..POSITIONS.len()).map(move |ix| (ix, iy)));
+    let values = grid()
+        .map(|(ix, iy)| match at(ix, iy) {
+            Some(c) if c.exact != 0.0 => c.coverage_2sigma,
+            _ => f64::NAN,
         })
         .collect();
-    let log_t: Vec<f64> = THICKNESSES.iter().map(|t| t.log10()).collect();
-    let half = 0.5 * (log_t[1] - log_t[0]);
-    let mut y_edges: Vec<f64> = log_t.iter().map(|t| t - half).collect();
-    y_edges.push(log_t[log_t.len() - 1] + half);
+    let markers = |color: usize, share: fn(&Cell) -> f64| {
+        let points = grid()
+            .filter(|&(ix, iy)| at(ix, iy).is_some_and(|c| c.exact != 0.0 && share(c) > 0.5))
+            .map(|(ix, iy)| (ix as f64, iy as f64, 0.0))
+            .collect();
+        Series::points("", color, points)
+    };
+    let edges = |n: usize| (0..=n).map(|i| i as f64 - 0.5).collect();
     Panel {
-        title: format!("{}, ω = {:+}, λ = {albedo}", method.name(), omega.sign()),
-        x_label: format!("x/π̃; colour: {what}"),
-        x_tick_names: POSITIONS.iter().map(|p| format!("{p}")).collect(),
-        y_label: "optical thickness κe·π̃".into(),
-        y_log: true,
+        title,
+        x_label: "x / length (non-uniform grid)".into(),
+        x_tick_names: position_names(),
+        y_label: "optical thickness κe × length".into(),
+        y_tick_names: thicknesses.iter().map(|&t| two_digits(t)).collect(),
+        series: vec![
+            markers(FLAGGED_COLOR, |c| c.flagged),
+            markers(ZERO_COLOR, |c| c.zero_stderr),
+        ],
         heat: Some(HeatMap {
-            x_edges: (0..=POSITIONS.len()).map(|i| i as f64 - 0.5).collect(),
-            y_edges,
+            x_edges: edges(POSITIONS.len()),
+            y_edges: edges(thicknesses.len()),
             values,
-            range: (0.0, 0.5),
+            range: COVERAGE_RANGE,
         }),
         ..Panel::default()
     }
 }
 
-/// Writes `stability.{png,svg}` (fraction of runs whose ±2σ bar misses the
-/// exact `s`), `stability_flagged.{png,svg}` (fraction flagged by the VOV)
-/// and `stability.json` (every cell).
+/// The colour legend, with the markers' and grey cells' meaning.
+fn legend(record: &Record) -> Panel {
+    let mut bar = colour_bar(
+        &format!(
+            "{} runs of {} paths per cell; grey: s = 0 (x = 0, ω = +1)",
+            record.runs, record.paths
+        ),
+        "colour: coverage, fraction of runs with |mean − s| ≤ 2σ (honest: 0.954)",
+        COVERAGE_RANGE,
+        (COVERAGE_RANGE.1, 1.0),
+    );
+    bar.series.extend([
+        Series::points("most runs flagged (VOV ≥ 0.1)", FLAGGED_COLOR, vec![]),
+        Series::points(
+            "most runs report σ = 0 (no weight drawn)",
+            ZERO_COLOR,
+            vec![],
+        ),
+    ]);
+    bar
+}
+
+/// Writes `stability.{png,svg}` (the coverage of every cell, markers where
+/// the diagnostic flags most runs or most runs report `σ = 0`) and
+/// `stability.json` (every cell's numbers).
 pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let mut jobs = Vec::new();
-    for (method, omega) in ROWS {
-        for &albedo in &ALBEDOS {
-            for &thickness in &THICKNESSES {
-                for &position in &POSITIONS {
-                    jobs.push((method, omega, albedo, thickness, position));
-                }
+    let thicknesses = thicknesses();
+    let cells = measure_all(opts)?;
+    let record = Record {
+        positions: POSITIONS.to_vec(),
+        thicknesses: thicknesses.clone(),
+        albedos: ALBEDOS.to_vec(),
+        length: LENGTH,
+        runs: RUNS,
+        paths: opts.paths(PATHS),
+        cells,
+    };
+    let mut panels = Vec::new();
+    for method in METHODS {
+        for omega in [Direction::Left, Direction::Right] {
+            for &albedo in &ALBEDOS {
+                let of_panel: Vec<&Cell> = record
+                    .cells
+                    .iter()
+                    .filter(|c| {
+                        c.method == method.name() && c.omega == omega.sign() && c.albedo == albedo
+                    })
+                    .collect();
+                let sign = if omega == Direction::Right {
+                    "+"
+                } else {
+                    "−"
+                };
+                let title = format!("{}, ω = {sign}1, λ = {albedo}", method.name());
+                panels.push(panel(&of_panel, &thicknesses, title));
             }
         }
     }
-    let bar = opts.bar(jobs.len() as u64, "stability map");
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .build()
-        .map_err(|e| Error::Config(format!("cannot start {} threads: {e}", opts.threads)))?;
-    let cells: Vec<Cell> = pool.install(|| {
-        jobs.par_iter()
-            .enumerate()
-            .map(|(i, &(method, omega, albedo, thickness, position))| {
-                let cell = measure(opts, method, omega, albedo, thickness, position, i as u64);
-                bar.inc(1);
-                cell
-            })
-            .collect::<Result<_, _>>()
-    })?;
-    bar.finish();
-    let figure = |what: &str, value: fn(&Cell) -> f64| {
-        let panels = ROWS
-            .iter()
-            .flat_map(|&row| ALBEDOS.iter().map(move |&a| (row, a)))
-            .map(|(row, a)| panel(&cells, row, a, what, value))
-            .collect();
-        let mut f = Figure::new(panels, ALBEDOS.len());
-        f.panel_size = (560, 400);
-        f
-    };
-    let scale = "blue 0, white .25, red ≥ .5";
-    let missed = format!("share of runs missing ±2σ ({scale}; honest .046)");
-    let flagged = format!("share of runs flagged by VOV ≥ 0.1 ({scale})");
-    let mut written = figure(&missed, |c| c.missed_2sigma).save(&opts.out, "stability")?;
-    written.extend(figure(&flagged, |c| c.flagged).save(&opts.out, "stability_flagged")?);
-    written.push(opts.write_json("stability", &cells)?);
+    panels.push(legend(&record));
+    let mut figure = Figure::new(panels, ALBEDOS.len());
+    figure.panel_size = (540, 340);
+    let mut written = figure.save(&opts.out, "stability")?;
+    written.push(opts.write_json("stability", &record)?);
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_and_labels() {
+        let t = thicknesses();
+        assert_eq!(t.len(), THICKNESS_COUNT);
+        assert!((t[0] - 0.1).abs() < 1e-12 && (t[t.len() - 1] - 30.0).abs() < 1e-9);
+        let names: Vec<String> = t.iter().map(|&v| two_digits(v)).collect();
+        assert_eq!(names[0], "0.10");
+        assert_eq!(names[4], "1.7");
+        assert_eq!(names[8], "30");
+        let p = position_names();
+        assert_eq!((p[0].as_str(), p[2].as_str()), ("0", ".25"));
+        assert_eq!((p[11].as_str(), p[12].as_str()), (".9999", "1"));
+    }
+
+    #[test]
+    fn writes_the_figure_and_every_cell() {
+        let dir = std::env::temp_dir().join(format!("geosens-stability-{}", std::process::id()));
+        let opts = FigureOptions {
+            effort: 1e-4,
+            progress: false,
+            ..FigureOptions::new(&dir)
+        };
+        let written = stability(&opts).unwrap();
+        let names: Vec<_> = written.iter().filter_map(|p| p.file_name()).collect();
+        assert_eq!(names, ["stability.png", "stability.svg", "stability.json"]);
+        let json = std::fs::read_to_string(dir.join("stability.json")).unwrap();
+        let cells = serde_json::from_str::<serde_json::Value>(&json).unwrap()["cells"]
+            .as_array()
+            .map(Vec::len);
+        let expected = METHODS.len() * 2 * ALBEDOS.len() * THICKNESS_COUNT * POSITIONS.len();
+        assert_eq!(cells, Some(expected));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
