@@ -1,5 +1,5 @@
 //! Finite differences of two Monte Carlo runs, independent and with common
-//! random numbers, against the step size (the book's introduction).
+//! random numbers, against the half step (the book's "Introduction").
 //!
 //! ```text
 //! cargo run --release --example fig_finite_difference -- [OUT_DIR] [EFFORT]
