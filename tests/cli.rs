@@ -333,6 +333,8 @@ fn compare_writes_the_figures() {
         "sensitivity_along_rod",
         "convergence",
         "efficiency",
+        "stability",
+        "finite_difference",
     ] {
         for ext in ["png", "svg"] {
             let path = dir.join(format!("{name}.{ext}"));
