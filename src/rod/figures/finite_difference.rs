@@ -264,22 +264,4 @@ mod tests {
         assert!((b2 / b3 - 100.0).abs() < 0.5, "{b2} / {b3}");
         assert!(bias(1e-7).is_none());
     }
-
-    #[test]
-    fn writes_the_figure_and_its_numbers() {
-        let dir = std::env::temp_dir().join(format!("geosens-fd-{}", std::process::id()));
-        let opts = FigureOptions {
-            effort: 1e-4,
-            progress: false,
-            ..FigureOptions::new(&dir)
-        };
-        let written = finite_difference(&opts).unwrap();
-        assert_eq!(written.len(), 3);
-        assert!(
-            written
-                .iter()
-                .all(|p| p.metadata().is_ok_and(|m| m.len() > 0))
-        );
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
 }
