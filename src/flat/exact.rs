@@ -1,0 +1,1 @@
+//! Closed-form and quadrature references for flatland irradiance.

@@ -1,0 +1,4 @@
+//! Flatland: polygon scenes in the plane whose shapes translate, rotate and
+//! scale, with the rod's estimator interface. The book's chapter "Flatland"
+//! derives every estimator.
+pub mod exact;
