@@ -19,6 +19,10 @@ pub enum Error {
     /// The run configuration cannot be honoured (thread pool, sample count).
     #[error("invalid run configuration: {0}")]
     Config(String),
+    /// A scene is invalid (geometry, coefficients, parameters, sensor) or
+    /// its file cannot be read.
+    #[error("invalid scene: {0}")]
+    Scene(String),
     /// Writing a result (figure, table) failed.
     #[error("{0}")]
     Output(String),

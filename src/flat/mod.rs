@@ -2,3 +2,7 @@
 //! scale, with the rod's estimator interface. The book's chapter "Flatland"
 //! derives every estimator.
 pub mod exact;
+pub mod geometry;
+pub mod scene;
+
+pub use scene::{Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface};
