@@ -635,7 +635,7 @@ fn check_medium(name: &str, m: &Medium) -> Result<(), Error> {
         ));
     }
     if let Phase::HenyeyGreenstein { g } = m.phase
-        && !(g.abs() < 1.0)
+        && (g.abs() >= 1.0 || g.is_nan())
     {
         return config(format!(
             "shape {name:?}: Henyey–Greenstein g = {g} is not in (−1, 1)"
