@@ -3,6 +3,10 @@
 //! derives every estimator.
 pub mod exact;
 pub mod geometry;
+pub mod methods;
 pub mod scene;
+pub mod trace;
+mod walk;
 
+pub use methods::Method;
 pub use scene::{Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface};

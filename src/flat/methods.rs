@@ -1,0 +1,186 @@
+//! The flatland estimators behind the crate's [`Estimator`] interface: one
+//! call samples one path (with its nested paths) and writes `I` then
+//! `∂I/∂π_j` for every declared parameter, in declaration order.
+//!
+//! - [`Method::Intensity`]: backward path tracing ([`trace`](super::trace));
+//! - [`Method::Rendering`], [`Method::Expectation`]: the differentiated walk
+//!   ([`walk`](super::walk)) with its two deformations;
+//! - [`Method::Fd`]: central differences with common random numbers, one
+//!   pair of displaced scenes per parameter.
+use super::geometry::NO_SEGMENT;
+use super::scene::{Scene, Sensor};
+use super::trace::{cosine_direction, radiance};
+use super::walk::{Scheme, Slots, Walk};
+use crate::error::{Error, check};
+use crate::estimator::{Estimator, Quantity};
+use crate::rng::PathRng;
+use std::sync::Arc;
+
+/// A flatland estimation method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Backward path tracing of `I` only.
+    Intensity,
+    /// Expectation differentiation: the warp field and stretched free paths;
+    /// `I` and every `∂I/∂π` from the same path.
+    Expectation,
+    /// Differentiable rendering: boundary terms at corners and medium
+    /// boundaries, joined by double randomisation.
+    Rendering,
+    /// Central finite differences with common random numbers (step
+    /// [`FD_STEP`] × scene size).
+    Fd,
+}
+
+/// Half step of [`Method::Fd`], relative to the scene size (radians for a
+/// rotation, relative change for a scale).
+pub const FD_STEP: f64 = 1e-3;
+
+impl Method {
+    /// The method's name, as the CLI spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Intensity => "intensity",
+            Method::Expectation => "expectation",
+            Method::Rendering => "rendering",
+            Method::Fd => "fd",
+        }
+    }
+
+    /// The estimator of this method on `scene`.
+    pub fn estimator(self, scene: Arc<Scene>) -> Result<Box<dyn Estimator>, Error> {
+        Ok(match self {
+            Method::Intensity => Box::new(IntensityEstimator { scene }),
+            Method::Expectation | Method::Rendering => Box::new(DerivativeEstimator {
+                slots: Slots::new(&scene, false),
+                scene,
+                scheme: if self == Method::Expectation {
+                    Scheme::Expectation
+                } else {
+                    Scheme::Rendering
+                },
+            }),
+            Method::Fd => Box::new(FiniteDifference::new(scene, FD_STEP)?),
+        })
+    }
+}
+
+/// `I` then one sensitivity per parameter.
+fn sensitivities(scene: &Scene) -> Vec<Quantity> {
+    std::iter::once(Quantity::Intensity)
+        .chain(
+            scene
+                .parameters()
+                .iter()
+                .map(|p| Quantity::sensitivity(&p.name)),
+        )
+        .collect()
+}
+
+/// One-sample estimate of the sensor's reading.
+#[inline]
+fn reading(scene: &Scene, rng: &mut PathRng) -> f64 {
+    let x = scene.sensor().point();
+    let medium = scene.sensor_medium();
+    match scene.sensor() {
+        Sensor::Radiance { direction, .. } => {
+            radiance(scene, rng, x, direction, medium, NO_SEGMENT)
+        }
+        Sensor::Irradiance { normal, .. } => {
+            let w = cosine_direction(normal, rng);
+            2.0 * radiance(scene, rng, x, w, medium, NO_SEGMENT)
+        }
+    }
+}
+
+/// Backward path tracing of the sensor's reading.
+pub struct IntensityEstimator {
+    /// The scene.
+    pub scene: Arc<Scene>,
+}
+
+impl Estimator for IntensityEstimator {
+    fn method(&self) -> &'static str {
+        "intensity"
+    }
+    fn quantities(&self) -> Vec<Quantity> {
+        vec![Quantity::Intensity]
+    }
+    #[inline]
+    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
+        weights[0] = reading(&self.scene, rng);
+    }
+}
+
+/// The differentiated walk: `I` and all sensitivities from one path.
+pub struct DerivativeEstimator {
+    scene: Arc<Scene>,
+    slots: Slots,
+    scheme: Scheme,
+}
+
+impl Estimator for DerivativeEstimator {
+    fn method(&self) -> &'static str {
+        match self.scheme {
+            Scheme::Rendering => "rendering",
+            Scheme::Expectation => "expectation",
+        }
+    }
+    fn quantities(&self) -> Vec<Quantity> {
+        sensitivities(&self.scene)
+    }
+    #[inline]
+    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
+        Walk {
+            scene: &self.scene,
+            slots: &self.slots,
+            scheme: self.scheme,
+        }
+        .sample(rng, weights);
+    }
+}
+
+/// Central differences with common random numbers: per parameter `j`, the
+/// reading of the scene displaced by `±h_j` from copies of one generator
+/// state; `I` from the nominal scene with the same state.
+pub struct FiniteDifference {
+    scene: Arc<Scene>,
+    displaced: Vec<(Scene, Scene, f64)>,
+}
+
+impl FiniteDifference {
+    /// Half step `h` relative to the scene size for translations and
+    /// absolute for rotations (radians) and scales; errors if `h` is not
+    /// finite and positive or a displaced scene is invalid (shapes touching).
+    pub fn new(scene: Arc<Scene>, h: f64) -> Result<FiniteDifference, Error> {
+        let h = check("h", h, h > 0.0, "a finite number > 0")?;
+        let displaced = (0..scene.parameters().len())
+            .map(|j| {
+                let step = match scene.parameters()[j].motion {
+                    super::Motion::TranslateX | super::Motion::TranslateY => h * scene.size(),
+                    _ => h,
+                };
+                Ok((scene.displaced(j, step)?, scene.displaced(j, -step)?, step))
+            })
+            .collect::<Result<_, Error>>()?;
+        Ok(FiniteDifference { scene, displaced })
+    }
+}
+
+impl Estimator for FiniteDifference {
+    fn method(&self) -> &'static str {
+        "fd"
+    }
+    fn quantities(&self) -> Vec<Quantity> {
+        sensitivities(&self.scene)
+    }
+    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
+        let start = rng.clone();
+        weights[0] = reading(&self.scene, rng);
+        for (w, (plus, minus, h)) in weights[1..].iter_mut().zip(&self.displaced) {
+            let p = reading(plus, &mut start.clone());
+            let m = reading(minus, &mut start.clone());
+            *w = (p - m) / (2.0 * h);
+        }
+    }
+}

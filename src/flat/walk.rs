@@ -1,0 +1,535 @@
+//! The differentiated backward walk shared by the *rendering* and
+//! *expectation* estimators. Every vertex of the path carries, per parameter
+//! `j`, a velocity `u_j = ∂x/∂π_j` and its outgoing direction an angular
+//! velocity `φ̇_j`: a choice of how the sampled path deforms when `π_j`
+//! changes. The path weight is differentiated along that deformation (the
+//! running score `Λ_j`), and whatever the deformation does not carry along
+//! becomes a boundary term:
+//!
+//! - **free paths** inside a medium run on `[0, t_b]`, `t_b` the distance to
+//!   the next boundary, whose velocity `ṫ_b` follows from the boundary's
+//!   motion. *Expectation* stretches the domain (`ξ̇ = ξ ṫ_b / t_b`, score
+//!   `ṫ_b/t_b − κe ξ̇`), as on the rod; *rendering* keeps `ξ` fixed and adds
+//!   the Leibniz term `κs e^{−κe t_b} L_s(t_b⁻) ṫ_b`, `L_s` from a nested
+//!   path;
+//! - **directions** at the sensor, at reflectors and at collisions are
+//!   integrated over the circle, where the integrand jumps at the corners of
+//!   opaque shapes seen from the vertex. *Rendering* turns directions with
+//!   the local frame and adds, for one corner drawn at random, the jump
+//!   `f (L⁻ − L⁺)` times the corner's angular velocity relative to the frame,
+//!   `L⁻`, `L⁺` from two nested paths just either side (double
+//!   randomisation). *Expectation* moves directions with a warp: the
+//!   piecewise-linear field on the circle through the angular velocities of
+//!   the visible corners (and of the frame at the horizons), continuous, so
+//!   no boundary term is left; its slope enters the score.
+//!
+//! Book: chapter "Flatland", sections "One deformation, two estimators" and
+//! "The warp field".
+// Slots index several parallel per-parameter arrays at once; index loops
+// read like the formulas.
+#![allow(clippy::needless_range_loop)]
+use super::geometry::{NO_SEGMENT, cross, perp};
+use super::scene::{MAX_PARAMETERS, Phase, Scene, Sensor, Surface};
+use super::trace::{
+    cosine_direction, crossed, free_path, phase_direction, phase_log_slope, phase_value, radiance,
+    survives,
+};
+use crate::rng::PathRng;
+use glam::DVec2;
+use rand::RngExt;
+
+/// Derivative slots a walk carries: every parameter, then the sensor's two
+/// gradient axes.
+pub(crate) const MAX_SLOTS: usize = MAX_PARAMETERS + 2;
+
+/// Half-angle (radians) between the two nested paths of a corner's jump.
+const JUMP_EPS: f64 = 1e-7;
+
+/// How the path deforms with the parameters, and what is left as boundary
+/// terms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scheme {
+    /// Fixed free paths and frame-attached directions; boundary terms by
+    /// double randomisation.
+    Rendering,
+    /// Stretched free paths and the corner warp; no boundary term.
+    Expectation,
+}
+
+/// What a walk differentiates: the scene's parameters and optionally the
+/// sensor position (`∂I/∂x`, `∂I/∂y`).
+#[derive(Debug, Clone)]
+pub(crate) struct Slots {
+    /// Number of parameters.
+    pub params: usize,
+    /// Whether the two gradient slots follow.
+    pub gradient: bool,
+    /// Indices (into `scene.corners()`) of the corners of moving shapes.
+    pub moving_corners: Vec<u32>,
+}
+
+impl Slots {
+    pub(crate) fn new(scene: &Scene, gradient: bool) -> Slots {
+        let params = scene.parameters().len();
+        let moving = |k: u32| (0..params).any(|j| scene.parameter_shape(j) == k);
+        let moving_corners = scene
+            .corners()
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| moving(c.1))
+            .map(|(i, _)| i as u32)
+            .collect();
+        Slots {
+            params,
+            gradient,
+            moving_corners,
+        }
+    }
+
+    /// Number of derivative slots.
+    #[inline]
+    pub(crate) fn len(&self) -> usize {
+        self.params + if self.gradient { 2 } else { 0 }
+    }
+
+    /// Velocity of the material point `q` of shape `k` for slot `j`.
+    #[inline]
+    fn velocity(&self, scene: &Scene, j: usize, k: u32, q: DVec2) -> DVec2 {
+        if j < self.params && scene.parameter_shape(j) == k {
+            scene.parameters()[j].motion.velocity(q)
+        } else {
+            DVec2::ZERO
+        }
+    }
+
+    /// Turning rate of shape `k`'s directions for slot `j`.
+    #[inline]
+    fn spin(&self, scene: &Scene, j: usize, k: u32) -> f64 {
+        if j < self.params && scene.parameter_shape(j) == k {
+            scene.parameters()[j].motion.spin()
+        } else {
+            0.0
+        }
+    }
+
+    /// Velocity of the sensor point for slot `j`.
+    #[inline]
+    fn sensor_velocity(&self, j: usize) -> DVec2 {
+        match j.checked_sub(self.params) {
+            Some(0) => DVec2::X,
+            Some(1) => DVec2::Y,
+            _ => DVec2::ZERO,
+        }
+    }
+}
+
+/// The integrand over directions at a vertex, up to the radiance.
+#[derive(Debug, Clone, Copy)]
+enum Lobe {
+    /// `c · (ω·n)⁺`: the sensor (`c = 1`) or a Lambertian reflector
+    /// (`c = ρ/2`).
+    Cosine { n: DVec2, c: f64 },
+    /// `p(ω·w_in)` at a collision.
+    Phase { phase: Phase, w_in: DVec2 },
+}
+
+impl Lobe {
+    #[inline]
+    fn value(&self, w: DVec2) -> f64 {
+        match *self {
+            Lobe::Cosine { n, c } => c * w.dot(n).max(0.0),
+            Lobe::Phase { phase, w_in } => phase_value(phase, w.dot(w_in)),
+        }
+    }
+
+    /// Integrand over density of the sampled direction.
+    #[inline]
+    fn weight(&self) -> f64 {
+        match *self {
+            Lobe::Cosine { c, .. } => 2.0 * c,
+            Lobe::Phase { .. } => 1.0,
+        }
+    }
+
+    #[inline]
+    fn sample(&self, rng: &mut PathRng) -> DVec2 {
+        match *self {
+            Lobe::Cosine { n, .. } => cosine_direction(n, rng),
+            Lobe::Phase { phase, w_in } => phase_direction(phase, w_in, rng),
+        }
+    }
+
+    /// `∂ ln f / ∂φ` at `w`: how the integrand changes when `w` turns
+    /// relative to the lobe's frame.
+    #[inline]
+    fn log_slope(&self, w: DVec2) -> f64 {
+        match *self {
+            Lobe::Cosine { n, .. } => -cross(n, w) / w.dot(n),
+            Lobe::Phase { phase, w_in } => phase_log_slope(phase, w.dot(w_in), cross(w_in, w)),
+        }
+    }
+
+    /// Angles from `w` to the lobe's horizon counter-clockwise and clockwise
+    /// (`2π` for the full circle). Horizons are fixed in the lobe's frame, so
+    /// the warp they pin is one field whatever direction was drawn.
+    #[inline]
+    fn horizons(&self, w: DVec2) -> (f64, f64) {
+        match *self {
+            Lobe::Cosine { n, .. } => {
+                // φ − φ_n in (−π/2, π/2).
+                let a = cross(n, w).atan2(n.dot(w));
+                (
+                    std::f64::consts::FRAC_PI_2 - a,
+                    std::f64::consts::FRAC_PI_2 + a,
+                )
+            }
+            // The whole circle: a knot found one way is found the other way
+            // too, and none found means no corner at all.
+            Lobe::Phase { .. } => (std::f64::consts::TAU, std::f64::consts::TAU),
+        }
+    }
+}
+
+/// Per-slot state of a walk.
+struct Deriv {
+    /// Vertex velocity `∂x/∂π_j`.
+    u: [DVec2; MAX_SLOTS],
+    /// Angular velocity of the current direction.
+    phid: [f64; MAX_SLOTS],
+    /// Running score `Λ_j`: derivative of the log weight along the
+    /// deformation.
+    score: [f64; MAX_SLOTS],
+    /// Boundary terms collected so far.
+    boundary: [f64; MAX_SLOTS],
+}
+
+/// A derivative walk: its context.
+pub(crate) struct Walk<'a> {
+    pub scene: &'a Scene,
+    pub slots: &'a Slots,
+    pub scheme: Scheme,
+}
+
+impl Walk<'_> {
+    /// One path: writes `I` into `out[0]` and the derivative of slot `j`
+    /// into `out[1 + j]`.
+    pub(crate) fn sample(&self, rng: &mut PathRng, out: &mut [f64]) {
+        let scene = self.scene;
+        let n = self.slots.len();
+        let mut d = Deriv {
+            u: [DVec2::ZERO; MAX_SLOTS],
+            phid: [0.0; MAX_SLOTS],
+            score: [0.0; MAX_SLOTS],
+            boundary: [0.0; MAX_SLOTS],
+        };
+        for j in 0..n {
+            d.u[j] = self.slots.sensor_velocity(j);
+        }
+        let mut x = scene.sensor().point();
+        let mut medium = scene.sensor_medium();
+        let mut skip = NO_SEGMENT;
+        let mut beta = 1.0;
+        let mut w = match scene.sensor() {
+            Sensor::Radiance { direction, .. } => direction,
+            Sensor::Irradiance { normal, .. } => {
+                let lobe = Lobe::Cosine { n: normal, c: 1.0 };
+                self.directions(rng, &mut d, x, medium, skip, &lobe, &[0.0; MAX_SLOTS], beta)
+            }
+        };
+        if let Sensor::Irradiance { .. } = scene.sensor() {
+            beta *= 2.0;
+        }
+        let mut intensity = 0.0;
+        let mut tb_dot = [0.0; MAX_SLOTS];
+        let mut depth = 0u32;
+        loop {
+            let hit = scene.cast(x, w, skip);
+            let wp = perp(w);
+            let t_b = hit.map_or(f64::INFINITY, |h| h.t);
+            if let Some(h) = hit {
+                // The hit point stays on the moving boundary: (ẏ − v)·n = 0
+                // with ẏ = u + ṫ_b w + t_b φ̇ w⊥.
+                let y = x + h.t * w;
+                let k = scene.owner(h.segment);
+                let nb = scene.normal(h.segment);
+                let wn = w.dot(nb);
+                for j in 0..n {
+                    let v = self.slots.velocity(scene, j, k, y);
+                    tb_dot[j] = (v - d.u[j] - h.t * d.phid[j] * wp).dot(nb) / wn;
+                }
+            } else {
+                tb_dot[..n].fill(0.0);
+            }
+            if let Some(m) = scene.medium(medium) {
+                if self.scheme == Scheme::Rendering && m.ks > 0.0 && hit.is_some() {
+                    // Leibniz term at the end of the free-path domain: the
+                    // in-scattered radiance just before the boundary.
+                    let end = x + t_b * (1.0 - 1e-9) * w;
+                    let wi = phase_direction(m.phase, w, rng);
+                    let ls = radiance(scene, rng, end, wi, medium, NO_SEGMENT);
+                    let term = beta * m.ks * (-m.ke * t_b).exp() * ls;
+                    for j in 0..n {
+                        d.boundary[j] += term * tb_dot[j];
+                    }
+                }
+                let xi = free_path(m.ks, rng);
+                let ka = m.ke - m.ks;
+                if xi < t_b {
+                    beta *= (-ka * xi).exp();
+                    for j in 0..n {
+                        let xi_dot = match self.scheme {
+                            Scheme::Expectation => {
+                                d.score[j] += tb_dot[j] / t_b;
+                                xi / t_b * tb_dot[j]
+                            }
+                            Scheme::Rendering => 0.0,
+                        };
+                        d.score[j] -= m.ke * xi_dot;
+                        d.u[j] += xi_dot * w + xi * d.phid[j] * wp;
+                    }
+                    x += xi * w;
+                    skip = NO_SEGMENT;
+                    let lobe = Lobe::Phase {
+                        phase: m.phase,
+                        w_in: w,
+                    };
+                    let spin = d.phid;
+                    w = self.directions(rng, &mut d, x, medium, skip, &lobe, &spin, beta);
+                    depth += 1;
+                    if !survives(depth, &mut beta, rng) {
+                        break;
+                    }
+                    continue;
+                }
+                beta *= (-ka * t_b).exp();
+                for j in 0..n {
+                    d.score[j] -= m.ke * tb_dot[j];
+                }
+            }
+            let Some(h) = hit else { break };
+            for j in 0..n {
+                d.u[j] += tb_dot[j] * w + h.t * d.phid[j] * wp;
+            }
+            x += h.t * w;
+            skip = h.segment;
+            let k = scene.owner(h.segment);
+            match scene.shapes()[k as usize].surface {
+                Surface::Emitter { radiance } => {
+                    let contribution = beta * radiance;
+                    intensity += contribution;
+                    for j in 0..n {
+                        d.boundary[j] += contribution * d.score[j];
+                    }
+                    break;
+                }
+                Surface::Absorber => break,
+                Surface::Transparent => medium = crossed(scene, medium, k),
+                Surface::Reflector { albedo } => {
+                    let nb = scene.normal(h.segment);
+                    let nb = if w.dot(nb) > 0.0 { -nb } else { nb };
+                    let lobe = Lobe::Cosine {
+                        n: nb,
+                        c: 0.5 * albedo,
+                    };
+                    let mut spin = [0.0; MAX_SLOTS];
+                    for (j, s) in spin.iter_mut().enumerate().take(n) {
+                        *s = self.slots.spin(scene, j, k);
+                    }
+                    w = self.directions(rng, &mut d, x, medium, skip, &lobe, &spin, beta);
+                    beta *= lobe.weight();
+                    depth += 1;
+                    if !survives(depth, &mut beta, rng) {
+                        break;
+                    }
+                }
+            }
+        }
+        out[0] = intensity;
+        out[1..=n].copy_from_slice(&d.boundary[..n]);
+    }
+
+    /// Samples the outgoing direction at vertex `x` from `lobe`, whose frame
+    /// turns at `spin[j]`; sets the direction's angular velocity, and adds
+    /// the boundary term (*rendering*) or the warp's score (*expectation*).
+    #[allow(clippy::too_many_arguments)]
+    fn directions(
+        &self,
+        rng: &mut PathRng,
+        d: &mut Deriv,
+        x: DVec2,
+        medium: Option<u32>,
+        skip: u32,
+        lobe: &Lobe,
+        spin: &[f64; MAX_SLOTS],
+        beta: f64,
+    ) -> DVec2 {
+        let n = self.slots.len();
+        match self.scheme {
+            Scheme::Rendering => {
+                self.corner_jump(rng, d, x, medium, skip, lobe, spin, beta);
+                let w = lobe.sample(rng);
+                d.phid[..n].copy_from_slice(&spin[..n]);
+                w
+            }
+            Scheme::Expectation => {
+                let w = lobe.sample(rng);
+                self.warp(d, x, skip, lobe, spin, w);
+                w
+            }
+        }
+    }
+
+    /// Angular velocity, for slot `j`, of the direction from `x` (moving at
+    /// `u`) to the corner `q` of shape `k`.
+    #[inline]
+    fn corner_rate(&self, j: usize, x: DVec2, u: DVec2, q: DVec2, k: u32) -> f64 {
+        let r = q - x;
+        cross(r, self.slots.velocity(self.scene, j, k, q) - u) / r.length_squared()
+    }
+
+    /// The boundary term of the directional integral: one corner drawn
+    /// uniformly, its jump by two nested paths.
+    #[allow(clippy::too_many_arguments)]
+    fn corner_jump(
+        &self,
+        rng: &mut PathRng,
+        d: &mut Deriv,
+        x: DVec2,
+        medium: Option<u32>,
+        skip: u32,
+        lobe: &Lobe,
+        spin: &[f64; MAX_SLOTS],
+        beta: f64,
+    ) {
+        let n = self.slots.len();
+        let scene = self.scene;
+        let corners = scene.corners();
+        // A vertex that stays put in a frame that stays put sees only the
+        // corners of moving shapes move.
+        let moving = (0..n).any(|j| d.u[j] != DVec2::ZERO || spin[j] != 0.0);
+        let count = if moving {
+            corners.len()
+        } else {
+            self.slots.moving_corners.len()
+        };
+        if count == 0 {
+            return;
+        }
+        let pick = rng.random_range(0..count);
+        let (q, k) = if moving {
+            corners[pick]
+        } else {
+            corners[self.slots.moving_corners[pick] as usize]
+        };
+        let wq = (q - x).normalize();
+        let f = lobe.value(wq);
+        if f <= 0.0 || !scene.visible(x, q, skip) {
+            return;
+        }
+        let mut rates = [0.0; MAX_SLOTS];
+        let mut any = false;
+        for j in 0..n {
+            rates[j] = self.corner_rate(j, x, d.u[j], q, k) - spin[j];
+            any |= rates[j] != 0.0;
+        }
+        if !any {
+            return;
+        }
+        let minus = radiance(
+            scene,
+            rng,
+            x,
+            DVec2::from_angle(-JUMP_EPS).rotate(wq),
+            medium,
+            skip,
+        );
+        let plus = radiance(
+            scene,
+            rng,
+            x,
+            DVec2::from_angle(JUMP_EPS).rotate(wq),
+            medium,
+            skip,
+        );
+        // d/dπ ∫ f L dφ ∋ (f L)(φ_q⁻) φ̇_q − (f L)(φ_q⁺) φ̇_q.
+        let term = beta * f * (minus - plus) * count as f64;
+        for j in 0..n {
+            d.boundary[j] += term * rates[j];
+        }
+    }
+
+    /// The warp at `x` for the sampled direction `w`: the nearest visible
+    /// corner (or horizon) on each side are the knots; the field is linear
+    /// in angle between them.
+    fn warp(
+        &self,
+        d: &mut Deriv,
+        x: DVec2,
+        skip: u32,
+        lobe: &Lobe,
+        spin: &[f64; MAX_SLOTS],
+        w: DVec2,
+    ) {
+        let n = self.slots.len();
+        let (h_ccw, h_cw) = lobe.horizons(w);
+        let ccw = self.nearest_visible_corner(x, skip, lobe, w, h_ccw, true);
+        let cw = self.nearest_visible_corner(x, skip, lobe, w, h_cw, false);
+        let slope_log = lobe.log_slope(w);
+        for j in 0..n {
+            // Knot values: a corner's angular velocity, or the frame's at a
+            // horizon (which keeps the integrand's domain in place).
+            let (db, vb) = match ccw {
+                Some((delta, q, k)) => (delta, self.corner_rate(j, x, d.u[j], q, k)),
+                None => (h_ccw, spin[j]),
+            };
+            let (da, va) = match cw {
+                Some((delta, q, k)) => (delta, self.corner_rate(j, x, d.u[j], q, k)),
+                None => (h_cw, spin[j]),
+            };
+            let span = da + db;
+            let slope = (vb - va) / span;
+            let v = va + slope * da;
+            d.score[j] += slope + slope_log * (v - spin[j]);
+            d.phid[j] = v;
+        }
+    }
+
+    /// The visible corner nearest to `w` turning counter-clockwise (`ccw`)
+    /// or clockwise, closer than `limit` radians and inside the lobe:
+    /// `(angle, corner, shape)`.
+    fn nearest_visible_corner(
+        &self,
+        x: DVec2,
+        skip: u32,
+        lobe: &Lobe,
+        w: DVec2,
+        limit: f64,
+        ccw: bool,
+    ) -> Option<(f64, DVec2, u32)> {
+        let scene = self.scene;
+        let mut bound = 0.0;
+        loop {
+            let mut best: Option<(f64, DVec2, u32)> = None;
+            let mut best_angle = limit;
+            for &(q, k) in scene.corners() {
+                let r = q - x;
+                let mut a = cross(w, r).atan2(w.dot(r));
+                if !ccw {
+                    a = -a;
+                }
+                if a < 0.0 {
+                    a += 2.0 * std::f64::consts::PI;
+                }
+                if a > bound && a < best_angle && lobe.value(r.normalize()) > 0.0 {
+                    best_angle = a;
+                    best = Some((a, q, k));
+                }
+            }
+            let (a, q, _) = best?;
+            if scene.visible(x, q, skip) {
+                return best;
+            }
+            bound = a;
+        }
+    }
+}
