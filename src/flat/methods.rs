@@ -27,6 +27,10 @@ pub enum Method {
     /// Differentiable rendering: boundary terms at corners and medium
     /// boundaries, joined by double randomisation.
     Rendering,
+    /// Sensitivity transport: the path stays fixed in space; sources where
+    /// it meets moving boundaries, coupled to the radiance gradient there
+    /// (nested walks); also returns `∂I/∂x`, `∂I/∂y` at the sensor.
+    Transport,
     /// Central finite differences with common random numbers (step
     /// [`FD_STEP`] × scene size).
     Fd,
@@ -43,6 +47,7 @@ impl Method {
             Method::Intensity => "intensity",
             Method::Expectation => "expectation",
             Method::Rendering => "rendering",
+            Method::Transport => "transport",
             Method::Fd => "fd",
         }
     }
@@ -51,15 +56,17 @@ impl Method {
     pub fn estimator(self, scene: Arc<Scene>) -> Result<Box<dyn Estimator>, Error> {
         Ok(match self {
             Method::Intensity => Box::new(IntensityEstimator { scene }),
-            Method::Expectation | Method::Rendering => Box::new(DerivativeEstimator {
-                slots: Slots::new(&scene, false),
-                scene,
-                scheme: if self == Method::Expectation {
-                    Scheme::Expectation
-                } else {
-                    Scheme::Rendering
-                },
-            }),
+            Method::Expectation | Method::Rendering | Method::Transport => {
+                Box::new(DerivativeEstimator {
+                    slots: Slots::new(&scene, self == Method::Transport),
+                    scene,
+                    scheme: match self {
+                        Method::Expectation => Scheme::Expectation,
+                        Method::Rendering => Scheme::Rendering,
+                        _ => Scheme::Transport,
+                    },
+                })
+            }
             Method::Fd => Box::new(FiniteDifference::new(scene, FD_STEP)?),
         })
     }
@@ -124,10 +131,16 @@ impl Estimator for DerivativeEstimator {
         match self.scheme {
             Scheme::Rendering => "rendering",
             Scheme::Expectation => "expectation",
+            Scheme::Transport => "transport",
         }
     }
     fn quantities(&self) -> Vec<Quantity> {
-        sensitivities(&self.scene)
+        let mut q = sensitivities(&self.scene);
+        if self.slots.gradient {
+            q.push(Quantity::gradient("x"));
+            q.push(Quantity::gradient("y"));
+        }
+        q
     }
     #[inline]
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
@@ -135,6 +148,7 @@ impl Estimator for DerivativeEstimator {
             scene: &self.scene,
             slots: &self.slots,
             scheme: self.scheme,
+            frozen: false,
         }
         .sample(rng, weights);
     }

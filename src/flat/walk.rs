@@ -54,6 +54,9 @@ pub(crate) enum Scheme {
     Rendering,
     /// Stretched free paths and the corner warp; no boundary term.
     Expectation,
+    /// The path stays fixed in space (Eulerian): sources where it meets a
+    /// moving boundary, coupled to the radiance gradient there.
+    Transport,
 }
 
 /// What a walk differentiates: the scene's parameters and optionally the
@@ -203,42 +206,109 @@ struct Deriv {
     boundary: [f64; MAX_SLOTS],
 }
 
+/// How slot `j`'s path deforms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Rule {
+    /// Fixed free paths, frame-attached directions (rendering).
+    Fixed,
+    /// Stretched free paths, warped directions (expectation).
+    Stretch,
+    /// No deformation at all: the path is fixed in space (transport).
+    Euler,
+}
+
+impl Deriv {
+    fn new() -> Deriv {
+        Deriv {
+            u: [DVec2::ZERO; MAX_SLOTS],
+            phid: [0.0; MAX_SLOTS],
+            score: [0.0; MAX_SLOTS],
+            boundary: [0.0; MAX_SLOTS],
+        }
+    }
+}
+
 /// A derivative walk: its context.
 pub(crate) struct Walk<'a> {
     pub scene: &'a Scene,
     pub slots: &'a Slots,
     pub scheme: Scheme,
+    /// The scene stands still: a nested walk that estimates the gradient of
+    /// the radiance along given start velocities (transport's coupling).
+    pub frozen: bool,
 }
 
 impl Walk<'_> {
-    /// One path: writes `I` into `out[0]` and the derivative of slot `j`
-    /// into `out[1 + j]`.
+    #[inline]
+    fn rule(&self, j: usize) -> Rule {
+        match self.scheme {
+            Scheme::Rendering => Rule::Fixed,
+            Scheme::Expectation => Rule::Stretch,
+            Scheme::Transport if j < self.slots.params && !self.frozen => Rule::Euler,
+            Scheme::Transport => Rule::Fixed,
+        }
+    }
+
+    /// Velocity of the material point `q` of shape `k` for slot `j`.
+    #[inline]
+    fn velocity(&self, j: usize, k: u32, q: DVec2) -> DVec2 {
+        if self.frozen {
+            DVec2::ZERO
+        } else {
+            self.slots.velocity(self.scene, j, k, q)
+        }
+    }
+
+    /// Turning rate of shape `k` for slot `j`.
+    #[inline]
+    fn spin(&self, j: usize, k: u32) -> f64 {
+        if self.frozen {
+            0.0
+        } else {
+            self.slots.spin(self.scene, j, k)
+        }
+    }
+
+    /// One path from the sensor: writes `I` into `out[0]` and the derivative
+    /// of slot `j` into `out[1 + j]`.
     pub(crate) fn sample(&self, rng: &mut PathRng, out: &mut [f64]) {
         let scene = self.scene;
         let n = self.slots.len();
-        let mut d = Deriv {
-            u: [DVec2::ZERO; MAX_SLOTS],
-            phid: [0.0; MAX_SLOTS],
-            score: [0.0; MAX_SLOTS],
-            boundary: [0.0; MAX_SLOTS],
-        };
+        let mut d = Deriv::new();
         for j in 0..n {
             d.u[j] = self.slots.sensor_velocity(j);
         }
-        let mut x = scene.sensor().point();
-        let mut medium = scene.sensor_medium();
-        let mut skip = NO_SEGMENT;
-        let mut beta = 1.0;
-        let mut w = match scene.sensor() {
-            Sensor::Radiance { direction, .. } => direction,
+        let x = scene.sensor().point();
+        let medium = scene.sensor_medium();
+        let (w, beta) = match scene.sensor() {
+            Sensor::Radiance { direction, .. } => (direction, 1.0),
             Sensor::Irradiance { normal, .. } => {
                 let lobe = Lobe::Cosine { n: normal, c: 1.0 };
-                self.directions(rng, &mut d, x, medium, skip, &lobe, &[0.0; MAX_SLOTS], beta)
+                let fixed = [0.0; MAX_SLOTS];
+                let w = self.directions(rng, &mut d, n, x, medium, NO_SEGMENT, &lobe, &fixed, 1.0);
+                (w, lobe.weight())
             }
         };
-        if let Sensor::Irradiance { .. } = scene.sensor() {
-            beta *= 2.0;
-        }
+        out[0] = self.trace(rng, &mut d, n, x, w, medium, NO_SEGMENT, beta);
+        out[1..=n].copy_from_slice(&d.boundary[..n]);
+    }
+
+    /// Continues a path from `x` along `w` with throughput `beta`: returns
+    /// the radiance contribution and adds the derivatives of its first `n`
+    /// slots to `d.boundary`.
+    #[allow(clippy::too_many_arguments)]
+    fn trace(
+        &self,
+        rng: &mut PathRng,
+        d: &mut Deriv,
+        n: usize,
+        mut x: DVec2,
+        mut w: DVec2,
+        mut medium: Option<u32>,
+        mut skip: u32,
+        mut beta: f64,
+    ) -> f64 {
+        let scene = self.scene;
         let mut intensity = 0.0;
         let mut tb_dot = [0.0; MAX_SLOTS];
         let mut depth = 0u32;
@@ -254,14 +324,15 @@ impl Walk<'_> {
                 let nb = scene.normal(h.segment);
                 let wn = w.dot(nb);
                 for j in 0..n {
-                    let v = self.slots.velocity(scene, j, k, y);
+                    let v = self.velocity(j, k, y);
                     tb_dot[j] = (v - d.u[j] - h.t * d.phid[j] * wp).dot(nb) / wn;
                 }
             } else {
                 tb_dot[..n].fill(0.0);
             }
             if let Some(m) = scene.medium(medium) {
-                if self.scheme == Scheme::Rendering && m.ks > 0.0 && hit.is_some() {
+                let leibniz = (0..n).any(|j| self.rule(j) == Rule::Fixed && tb_dot[j] != 0.0);
+                if leibniz && m.ks > 0.0 && hit.is_some() {
                     // Leibniz term at the end of the free-path domain: the
                     // in-scattered radiance just before the boundary.
                     let end = x + t_b * (1.0 - 1e-9) * w;
@@ -269,7 +340,9 @@ impl Walk<'_> {
                     let ls = radiance(scene, rng, end, wi, medium, NO_SEGMENT);
                     let term = beta * m.ks * (-m.ke * t_b).exp() * ls;
                     for j in 0..n {
-                        d.boundary[j] += term * tb_dot[j];
+                        if self.rule(j) == Rule::Fixed {
+                            d.boundary[j] += term * tb_dot[j];
+                        }
                     }
                 }
                 let xi = free_path(m.ks, rng);
@@ -277,12 +350,12 @@ impl Walk<'_> {
                 if xi < t_b {
                     beta *= (-ka * xi).exp();
                     for j in 0..n {
-                        let xi_dot = match self.scheme {
-                            Scheme::Expectation => {
+                        let xi_dot = match self.rule(j) {
+                            Rule::Stretch => {
                                 d.score[j] += tb_dot[j] / t_b;
                                 xi / t_b * tb_dot[j]
                             }
-                            Scheme::Rendering => 0.0,
+                            Rule::Fixed | Rule::Euler => 0.0,
                         };
                         d.score[j] -= m.ke * xi_dot;
                         d.u[j] += xi_dot * w + xi * d.phid[j] * wp;
@@ -294,7 +367,7 @@ impl Walk<'_> {
                         w_in: w,
                     };
                     let spin = d.phid;
-                    w = self.directions(rng, &mut d, x, medium, skip, &lobe, &spin, beta);
+                    w = self.directions(rng, d, n, x, medium, skip, &lobe, &spin, beta);
                     depth += 1;
                     if !survives(depth, &mut beta, rng) {
                         break;
@@ -303,18 +376,27 @@ impl Walk<'_> {
                 }
                 beta *= (-ka * t_b).exp();
                 for j in 0..n {
-                    d.score[j] -= m.ke * tb_dot[j];
+                    if self.rule(j) != Rule::Euler {
+                        d.score[j] -= m.ke * tb_dot[j];
+                    }
                 }
             }
             let Some(h) = hit else { break };
+            let before = x;
             for j in 0..n {
-                d.u[j] += tb_dot[j] * w + h.t * d.phid[j] * wp;
+                if self.rule(j) != Rule::Euler {
+                    d.u[j] += tb_dot[j] * w + h.t * d.phid[j] * wp;
+                }
             }
             x += h.t * w;
             skip = h.segment;
             let k = scene.owner(h.segment);
+            let euler = (0..n).any(|j| self.rule(j) == Rule::Euler && tb_dot[j] != 0.0);
             match scene.shapes()[k as usize].surface {
                 Surface::Emitter { radiance } => {
+                    if euler {
+                        self.surface_gradient(rng, d, n, before, x, w, medium, beta, k);
+                    }
                     let contribution = beta * radiance;
                     intensity += contribution;
                     for j in 0..n {
@@ -322,8 +404,19 @@ impl Walk<'_> {
                     }
                     break;
                 }
-                Surface::Absorber => break,
-                Surface::Transparent => medium = crossed(scene, medium, k),
+                Surface::Absorber => {
+                    if euler {
+                        self.surface_gradient(rng, d, n, before, x, w, medium, beta, k);
+                    }
+                    break;
+                }
+                Surface::Transparent => {
+                    let next = crossed(scene, medium, k);
+                    if euler {
+                        self.interface_source(rng, d, n, x, w, medium, next, beta, &tb_dot);
+                    }
+                    medium = next;
+                }
                 Surface::Reflector { albedo } => {
                     let nb = scene.normal(h.segment);
                     let nb = if w.dot(nb) > 0.0 { -nb } else { nb };
@@ -333,9 +426,48 @@ impl Walk<'_> {
                     };
                     let mut spin = [0.0; MAX_SLOTS];
                     for (j, s) in spin.iter_mut().enumerate().take(n) {
-                        *s = self.slots.spin(scene, j, k);
+                        *s = self.spin(j, k);
                     }
-                    w = self.directions(rng, &mut d, x, medium, skip, &lobe, &spin, beta);
+                    let moving = (0..n).any(|j| {
+                        self.rule(j) == Rule::Euler
+                            && (spin[j] != 0.0 || self.velocity(j, k, x) != DVec2::ZERO)
+                    });
+                    if moving {
+                        self.surface_gradient(rng, d, n, before, x, w, medium, beta, k);
+                        // The material derivative of the reflected
+                        // radiance: corners seen from the moving point.
+                        for j in 0..n {
+                            if self.rule(j) == Rule::Euler {
+                                d.u[j] = self.velocity(j, k, x);
+                            }
+                        }
+                    }
+                    w = self.directions(rng, d, n, x, medium, skip, &lobe, &spin, beta);
+                    if moving {
+                        // … and its regular part: the radiance reflected at
+                        // the moving point in the turning frame, by a
+                        // nested walk in the frozen scene.
+                        let mut g = Deriv::new();
+                        for j in 0..n {
+                            if self.rule(j) == Rule::Euler {
+                                g.u[j] = d.u[j];
+                                g.phid[j] = spin[j];
+                                d.u[j] = DVec2::ZERO;
+                            }
+                        }
+                        self.frozen()
+                            .trace(rng, &mut g, n, x, w, medium, skip, 1.0);
+                        for j in 0..n {
+                            if self.rule(j) == Rule::Euler {
+                                d.boundary[j] += beta * lobe.weight() * g.boundary[j];
+                            }
+                        }
+                    }
+                    for j in 0..n {
+                        if self.rule(j) == Rule::Euler {
+                            d.phid[j] = 0.0;
+                        }
+                    }
                     beta *= lobe.weight();
                     depth += 1;
                     if !survives(depth, &mut beta, rng) {
@@ -344,8 +476,89 @@ impl Walk<'_> {
                 }
             }
         }
-        out[0] = intensity;
-        out[1..=n].copy_from_slice(&d.boundary[..n]);
+        intensity
+    }
+
+    /// The same walk in the frozen scene, rendering rules for every slot.
+    fn frozen(&self) -> Walk<'_> {
+        Walk {
+            scene: self.scene,
+            slots: self.slots,
+            scheme: Scheme::Rendering,
+            frozen: true,
+        }
+    }
+
+    /// Transport's coupling at an opaque moving boundary hit at `y` from
+    /// `x` along `w`: the source `−v·∇L(y⁻, w)` for every Eulerian slot,
+    /// the gradient by a nested walk in the frozen scene started just before
+    /// `y` with velocity `v`.
+    #[allow(clippy::too_many_arguments)]
+    fn surface_gradient(
+        &self,
+        rng: &mut PathRng,
+        d: &mut Deriv,
+        n: usize,
+        x: DVec2,
+        y: DVec2,
+        w: DVec2,
+        medium: Option<u32>,
+        beta: f64,
+        k: u32,
+    ) {
+        let mut g = Deriv::new();
+        for j in 0..n {
+            if self.rule(j) == Rule::Euler {
+                g.u[j] = self.velocity(j, k, y);
+            }
+        }
+        let start = x + (y - x) * (1.0 - 1e-9);
+        self.frozen()
+            .trace(rng, &mut g, n, start, w, medium, NO_SEGMENT, 1.0);
+        for j in 0..n {
+            if self.rule(j) == Rule::Euler {
+                d.boundary[j] -= beta * g.boundary[j];
+            }
+        }
+    }
+
+    /// Transport's source where the path crosses a moving medium boundary
+    /// at `y` from medium `before` into `after`: the interface advancing by
+    /// `ṫ_b` along the ray swaps the coefficients of the points it sweeps,
+    /// `s ∋ ṫ_b [κs,b L_s,b − κs,a L_s,a − (κe,b − κe,a) L(y, w)]`; the
+    /// last term multiplies what the path goes on to collect (a score), the
+    /// in-scattered radiances come from one nested path on each side.
+    #[allow(clippy::too_many_arguments)]
+    fn interface_source(
+        &self,
+        rng: &mut PathRng,
+        d: &mut Deriv,
+        n: usize,
+        y: DVec2,
+        w: DVec2,
+        before: Option<u32>,
+        after: Option<u32>,
+        beta: f64,
+        tb_dot: &[f64; MAX_SLOTS],
+    ) {
+        let scene = self.scene;
+        let eps = 1e-9 * scene.size();
+        let side = |rng: &mut PathRng, medium: Option<u32>, at: DVec2| match scene.medium(medium) {
+            Some(m) if m.ks > 0.0 => {
+                let wi = phase_direction(m.phase, w, rng);
+                m.ks * radiance(scene, rng, at, wi, medium, NO_SEGMENT)
+            }
+            _ => 0.0,
+        };
+        let ke = |medium: Option<u32>| scene.medium(medium).map_or(0.0, |m| m.ke);
+        let scattered = side(rng, before, y - eps * w) - side(rng, after, y + eps * w);
+        let dke = ke(before) - ke(after);
+        for j in 0..n {
+            if self.rule(j) == Rule::Euler {
+                d.boundary[j] += beta * tb_dot[j] * scattered;
+                d.score[j] -= dke * tb_dot[j];
+            }
+        }
     }
 
     /// Samples the outgoing direction at vertex `x` from `lobe`, whose frame
@@ -356,6 +569,7 @@ impl Walk<'_> {
         &self,
         rng: &mut PathRng,
         d: &mut Deriv,
+        n: usize,
         x: DVec2,
         medium: Option<u32>,
         skip: u32,
@@ -363,17 +577,16 @@ impl Walk<'_> {
         spin: &[f64; MAX_SLOTS],
         beta: f64,
     ) -> DVec2 {
-        let n = self.slots.len();
         match self.scheme {
-            Scheme::Rendering => {
-                self.corner_jump(rng, d, x, medium, skip, lobe, spin, beta);
+            Scheme::Rendering | Scheme::Transport => {
+                self.corner_jump(rng, d, n, x, medium, skip, lobe, spin, beta);
                 let w = lobe.sample(rng);
                 d.phid[..n].copy_from_slice(&spin[..n]);
                 w
             }
             Scheme::Expectation => {
                 let w = lobe.sample(rng);
-                self.warp(d, x, skip, lobe, spin, w);
+                self.warp(d, n, x, skip, lobe, spin, w);
                 w
             }
         }
@@ -384,7 +597,7 @@ impl Walk<'_> {
     #[inline]
     fn corner_rate(&self, j: usize, x: DVec2, u: DVec2, q: DVec2, k: u32) -> f64 {
         let r = q - x;
-        cross(r, self.slots.velocity(self.scene, j, k, q) - u) / r.length_squared()
+        cross(r, self.velocity(j, k, q) - u) / r.length_squared()
     }
 
     /// The boundary term of the directional integral: one corner drawn
@@ -394,6 +607,7 @@ impl Walk<'_> {
         &self,
         rng: &mut PathRng,
         d: &mut Deriv,
+        n: usize,
         x: DVec2,
         medium: Option<u32>,
         skip: u32,
@@ -401,7 +615,6 @@ impl Walk<'_> {
         spin: &[f64; MAX_SLOTS],
         beta: f64,
     ) {
-        let n = self.slots.len();
         let scene = self.scene;
         let corners = scene.corners();
         // A vertex that stays put in a frame that stays put sees only the
@@ -464,13 +677,13 @@ impl Walk<'_> {
     fn warp(
         &self,
         d: &mut Deriv,
+        n: usize,
         x: DVec2,
         skip: u32,
         lobe: &Lobe,
         spin: &[f64; MAX_SLOTS],
         w: DVec2,
     ) {
-        let n = self.slots.len();
         let (h_ccw, h_cw) = lobe.horizons(w);
         let ccw = self.nearest_visible_corner(x, skip, lobe, w, h_ccw, true);
         let cw = self.nearest_visible_corner(x, skip, lobe, w, h_cw, false);
