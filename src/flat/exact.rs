@@ -27,7 +27,8 @@
 //! `c(θ)` the length of the sight line inside the polygon before the
 //! emitter. `E = Le Σ ∫_α^β cos(θ − θn) T dθ` is integrated by adaptive
 //! Gauss–Kronrod (7, 15) on pieces split at every kink of `c` (directions to
-//! the polygon's vertices and to its crossings with the emitter). With
+//! the polygon's vertices, its crossings with the emitter and its
+//! self-intersections), to a relative error well below 1e-8. With
 //! `c = Σ ±t_i` over the boundary crossings `t_i` (`+` leaving, `−` entering;
 //! plus the emitter's distance `t_e` when it lies inside), each crossing of a
 //! moving edge with unit normal `m` moves by `ṫ = (q̇·m)/(ω·m)`, and
@@ -37,9 +38,16 @@
 //!
 //! Shapes move by per-vertex velocities ([`Motion`] gives those of the four
 //! parameter kinds); edges stay straight, so edge points move by the
-//! interpolated velocity. At non-generic configurations (two interval-end
-//! directions coinciding, e.g. `p` on the line of a silhouette edge) `E` has
-//! a kink and the derivative is that of one side.
+//! interpolated velocity.
+//!
+//! Rejected with an [`Error`]: non-finite input, `Le < 0`, `κe < 0`, a
+//! degenerate emitter or edge, a sensor on the emitter's line, on or inside
+//! an occluder or on the medium's boundary, an occluder touching or crossing
+//! the emitter (the only way depth order could change along an interval),
+//! and an open medium. Not detected: non-generic configurations where two
+//! interval-end directions coincide (e.g. `p` on the line of a silhouette
+//! edge, or an occluder vertex in line with an emitter end); `E` has a kink
+//! there, and the derivative is that of the branch the tie-break picks.
 use std::f64::consts::{PI, TAU};
 
 use glam::DVec2;
@@ -201,6 +209,13 @@ fn segments_touch(p1: DVec2, p2: DVec2, q1: DVec2, q2: DVec2) -> bool {
     let ends = [(p1, q1, q2), (p2, q1, q2), (q1, p1, p2), (q2, p1, p2)];
     (apart(q1, q2, p1, p2) && apart(p1, p2, q1, q2))
         || ends.iter().any(|&(q, a, b)| on_segment(q, a, b))
+}
+
+/// The point where the segments `[u, v]` and `[a, b]` meet, if they do.
+fn crossing(u: DVec2, v: DVec2, a: DVec2, b: DVec2) -> Option<DVec2> {
+    let (d, e) = (v - u, b - a);
+    let (s, t) = (cross(a - u, e) / cross(d, e), cross(a - u, d) / cross(d, e));
+    ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t)).then(|| u + s * d)
 }
 
 /// What an interval end follows.
@@ -445,45 +460,31 @@ fn moving(shape: ShapeId, motion: Motion) -> impl Fn(ShapeId, DVec2) -> DVec2 {
     }
 }
 
-/// Gauss–Kronrod (7, 15) nodes and weights on `[−1, 1]` (QUADPACK `qk15`).
-const XGK: [f64; 8] = [
-    0.991_455_371_120_812_6,
-    0.949_107_912_342_758_5,
-    0.864_864_423_359_769_1,
-    0.741_531_185_599_394_4,
-    0.586_087_235_467_691_1,
-    0.405_845_151_377_397_2,
-    0.207_784_955_007_898_5,
-    0.0,
-];
-const WGK: [f64; 8] = [
-    0.022_935_322_010_529_225,
-    0.063_092_092_629_978_55,
-    0.104_790_010_322_250_18,
-    0.140_653_259_715_525_92,
-    0.169_004_726_639_267_9,
-    0.190_350_578_064_785_4,
-    0.204_432_940_075_298_9,
-    0.209_482_141_084_727_83,
-];
-const WG: [f64; 4] = [
-    0.129_484_966_168_869_7,
-    0.279_705_391_489_276_7,
-    0.381_830_050_505_118_9,
-    0.417_959_183_673_469_4,
+/// Gauss–Kronrod (7, 15) on `[−1, 1]` (QUADPACK `qk15`): node `x ≥ 0`,
+/// Kronrod weight, Gauss weight (0 at the Kronrod-only nodes).
+#[rustfmt::skip]
+const GK15: [(f64, f64, f64); 8] = [
+    (0.991_455_371_120_812_6, 0.022_935_322_010_529_225, 0.0),
+    (0.949_107_912_342_758_5, 0.063_092_092_629_978_55, 0.129_484_966_168_869_7),
+    (0.864_864_423_359_769_1, 0.104_790_010_322_250_18, 0.0),
+    (0.741_531_185_599_394_4, 0.140_653_259_715_525_92, 0.279_705_391_489_276_7),
+    (0.586_087_235_467_691_1, 0.169_004_726_639_267_9, 0.0),
+    (0.405_845_151_377_397_2, 0.190_350_578_064_785_4, 0.381_830_050_505_118_9),
+    (0.207_784_955_007_898_5, 0.204_432_940_075_298_9, 0.0),
+    (0.0, 0.209_482_141_084_727_83, 0.417_959_183_673_469_4),
 ];
 
 /// The Kronrod and Gauss estimates of `∫_a^b f`.
 fn gauss_kronrod(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> (f64, f64) {
     let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
-    let fc = f(c);
-    let (mut k, mut g) = (WGK[7] * fc, WG[3] * fc);
-    for j in 0..7 {
-        let pair = f(c - h * XGK[j]) + f(c + h * XGK[j]);
-        k += WGK[j] * pair;
-        if j % 2 == 1 {
-            g += WG[j / 2] * pair;
-        }
+    let (mut k, mut g) = (0.0, 0.0);
+    for (x, wk, wg) in GK15 {
+        let fx = if x == 0.0 {
+            f(c)
+        } else {
+            f(c - h * x) + f(c + h * x)
+        };
+        (k, g) = (k + wk * fx, g + wg * fx);
     }
     (k * h, g * h)
 }
@@ -505,8 +506,6 @@ pub struct AbsorbedIrradiance {
     view: OccludedIrradiance,
     medium: Shape,
     kappa_e: f64,
-    /// `+1` for a counter-clockwise medium polygon, `−1` otherwise.
-    orientation: f64,
     sensor_inside: bool,
     /// Kinks of the chord `c(θ)` (relative angles), sorted.
     kinks: Vec<f64>,
@@ -527,20 +526,19 @@ impl AbsorbedIrradiance {
                 "the sensor is on the medium's boundary".into(),
             ));
         }
-        let area: f64 = medium.edges().map(|(u, v)| cross(u, v)).sum();
-        let (a, b) = (view.emitter.a, view.emitter.b);
+        // c kinks at the directions to the vertices, the edges' crossings
+        // with the emitter and with one another (self-intersections).
         let mut kinks: Vec<f64> = medium.vertices.iter().map(|&q| view.angle(q)).collect();
-        for (u, v) in medium.edges() {
-            let (d, e) = (v - u, b - a);
-            let s = cross(a - u, e) / cross(d, e);
-            let t = cross(a - u, d) / cross(d, e);
-            if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t) {
-                kinks.push(view.angle(u + s * d));
-            }
+        let edges: Vec<_> = medium
+            .edges()
+            .chain([(view.emitter.a, view.emitter.b)])
+            .collect();
+        for (i, &(u, v)) in edges.iter().enumerate() {
+            let points = edges[..i].iter().filter_map(|&(x, y)| crossing(u, v, x, y));
+            kinks.extend(points.map(|q| view.angle(q)));
         }
         kinks.sort_by(f64::total_cmp);
         Ok(AbsorbedIrradiance {
-            orientation: if area >= 0.0 { 1.0 } else { -1.0 },
             sensor_inside: medium.contains(view.point),
             view,
             medium,
@@ -568,31 +566,31 @@ impl AbsorbedIrradiance {
         let (p, w) = (self.view.point, self.view.direction(phi));
         let (a, b) = (self.view.emitter.a, self.view.emitter.b);
         let t_end = self.view.distance(w, a, b);
-        let (mut inside, mut c, mut dc) = (i32::from(self.sensor_inside), 0.0, 0.0);
         // Rate of a crossing at fraction s of edge [u, v] of `id`: ṫ = (q̇·m)/(ω·m).
-        let rate = |vel: Velocity, id, u: DVec2, v: DVec2, s: f64| {
-            cross(v - u, vel(id, u).lerp(vel(id, v), s)) / cross(v - u, w)
+        let rate = |id, u: DVec2, v: DVec2, s: f64| {
+            velocity.map_or(0.0, |vel| {
+                cross(v - u, vel(id, u).lerp(vel(id, v), s)) / cross(v - u, w)
+            })
         };
+        // The crossings (t, ṫ) before the emitter, in order along the ray.
+        let mut hits = Vec::new();
         for (u, v) in self.medium.edges() {
             let den = cross(w, v - u);
             let (t, s) = (cross(u - p, v - u) / den, cross(u - p, w) / den);
-            if !(0.0..1.0).contains(&s) || t <= 0.0 || t >= t_end {
-                continue;
-            }
-            // +1 leaving the medium (ω along the outward normal), −1 entering.
-            let sign = (self.orientation * den).signum();
-            inside -= sign as i32;
-            c += sign * t;
-            if let Some(vel) = velocity {
-                dc += sign * rate(vel, ShapeId::Medium, u, v, s);
+            if (0.0..1.0).contains(&s) && t > 0.0 && t < t_end {
+                hits.push((t, rate(ShapeId::Medium, u, v, s)));
             }
         }
-        if inside > 0 {
+        hits.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let (mut inside, mut c, mut dc) = (self.sensor_inside, 0.0, 0.0);
+        for (t, dt) in hits {
+            // A crossing leaving the medium adds t to c, one entering it −t.
+            let sign = if inside { 1.0 } else { -1.0 };
+            (c, dc, inside) = (c + sign * t, dc + sign * dt, !inside);
+        }
+        if inside {
             c += t_end;
-            if let Some(vel) = velocity {
-                let s = cross(a - p, w) / cross(w, b - a);
-                dc += rate(vel, ShapeId::Emitter, a, b, s);
-            }
+            dc += rate(ShapeId::Emitter, a, b, cross(a - p, w) / cross(w, b - a));
         }
         (c, dc)
     }
@@ -700,6 +698,11 @@ mod tests {
     /// A non-convex medium around the sensor.
     fn around_sensor() -> Shape {
         Shape::polygon(pts(&[-0.6, -0.3, 0.7, -0.2, 0.5, 1.3, 0.0, 0.8, -0.4, 1.1])).unwrap()
+    }
+
+    /// A self-intersecting (bow-tie) medium crossing the emitter.
+    fn bow_tie() -> Shape {
+        Shape::polygon(pts(&[-0.8, 1.0, 1.6, 3.2, 1.6, 1.0, -0.8, 3.3])).unwrap()
     }
 
     /// Test-side ray cast from the origin along `w` onto `[u, q]`: `(t, s)`.
@@ -936,7 +939,7 @@ mod tests {
             occluders: vec![],
             ..scene()
         };
-        for medium in [s.medium.clone(), around_sensor()] {
+        for medium in [s.medium.clone(), around_sensor(), bow_tie()] {
             s.medium = medium;
             let (e, brute) = (s.absorbed().value(), s.brute(200_000, true));
             assert!((e - brute).abs() < 1e-8 * e, "{e} vs {brute}");
@@ -955,17 +958,19 @@ mod tests {
             ShapeId::Occluder(1),
         ];
         check_fd(&scene(), &ids, &absorbed_value, &absorbed_deriv);
-        let s = Scene {
-            occluders: vec![],
-            medium: around_sensor(),
-            ..scene()
-        };
-        check_fd(
-            &s,
-            &[ShapeId::Medium, ShapeId::Emitter],
-            &absorbed_value,
-            &absorbed_deriv,
-        );
+        for medium in [around_sensor(), bow_tie()] {
+            let s = Scene {
+                occluders: vec![],
+                medium,
+                ..scene()
+            };
+            check_fd(
+                &s,
+                &[ShapeId::Medium, ShapeId::Emitter],
+                &absorbed_value,
+                &absorbed_deriv,
+            );
+        }
     }
 
     #[test]
