@@ -19,7 +19,7 @@ pub const MAX_PARAMETERS: usize = 14;
 
 /// What happens to light arriving at a shape's boundary.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(from = "repr::Surface", into = "repr::Surface")]
 pub enum Surface {
     /// Two-sided Lambertian emitter of uniform radiance; absorbs what arrives.
     Emitter {
@@ -46,7 +46,7 @@ impl Surface {
 
 /// Angular distribution of scattering in a medium (normalised over the circle).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(from = "repr::Phase", into = "repr::Phase")]
 pub enum Phase {
     /// `p(θ) = 1/2π`.
     #[default]
@@ -109,7 +109,7 @@ impl Shape {
 
 /// How a parameter moves its shape.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(from = "repr::Motion", into = "repr::Motion")]
 pub enum Motion {
     /// Translation along x (π = offset, nominal 0).
     TranslateX,
@@ -118,13 +118,11 @@ pub enum Motion {
     /// Rotation about a pivot (π = angle in radians, nominal 0).
     Rotate {
         /// Pivot; the shape's centroid if absent.
-        #[serde(default)]
         pivot: Option<DVec2>,
     },
     /// Uniform scale about a pivot (π = factor − 1, nominal 0).
     Scale {
         /// Pivot; the shape's centroid if absent.
-        #[serde(default)]
         pivot: Option<DVec2>,
     },
 }
@@ -188,15 +186,19 @@ pub enum Sensor {
     /// sensor looks toward).
     Radiance {
         /// Where.
+        #[serde(deserialize_with = "repr::point")]
         point: DVec2,
         /// Looking direction (normalised on construction).
+        #[serde(deserialize_with = "repr::direction")]
         direction: DVec2,
     },
     /// Irradiance `E = ∫ L(ω) (ω·n)⁺ dθ` at `point` with unit normal `n`.
     Irradiance {
         /// Where.
+        #[serde(deserialize_with = "repr::point")]
         point: DVec2,
         /// Normal (normalised on construction).
+        #[serde(deserialize_with = "repr::normal")]
         normal: DVec2,
     },
 }
@@ -280,7 +282,7 @@ impl Scene {
     /// Validates and builds a scene. Errors name the shape or parameter at
     /// fault: non-finite or too few vertices, zero-length or crossing
     /// segments (within a shape or between shapes), coefficients out of
-    /// range (κs < 0, κe < κs, |g| ≥ 1, albedo ∉ [0,1], radiance < 0), a
+    /// range (κs < 0, κe < κs, |g| ≥ 1, albedo ∉ `[0, 1]`, radiance < 0), a
     /// medium on an open or opaque shape, a transparent shape without a
     /// medium, parameters naming no shape, duplicate names, a sensor on a
     /// segment or inside an opaque closed shape.
@@ -700,6 +702,150 @@ fn check_crossings(shapes: &[Shape], segments: &[Segment], owner: &[u32]) -> Res
         }
     }
     Ok(())
+}
+
+/// The file forms of [`Surface`], [`Phase`] and [`Motion`]: internally tagged
+/// (`kind = "absorber"`) with every variant a struct variant, because serde's
+/// `deny_unknown_fields` lets unknown fields through on the unit variants of
+/// an internally tagged enum (serde-rs/serde#2123): `{ kind = "absorber",
+/// albedo = 0.5 }` would load as a black absorber without a word.
+///
+/// The fields of tagged enums are read through [`field`]: serde buffers a
+/// tagged table before reading it, so the parser's position (TOML's span,
+/// JSON's line and column) is the whole table's and its message alone ("invalid
+/// type: string, expected f64") would not say which field is wrong.
+mod repr {
+    use glam::DVec2;
+    use serde::de::Error as _;
+    use serde::{Deserialize, Deserializer, Serialize};
+
+    /// Deserializes a field, naming it in the error.
+    fn field<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        name: &str,
+        d: D,
+    ) -> Result<T, D::Error> {
+        T::deserialize(d).map_err(|e| D::Error::custom(format_args!("field `{name}`: {e}")))
+    }
+
+    macro_rules! fields {
+        ($($name:ident: $t:ty),*) => {$(
+            pub(super) fn $name<'de, D: Deserializer<'de>>(d: D) -> Result<$t, D::Error> {
+                field(stringify!($name), d)
+            }
+        )*};
+    }
+    fields!(radiance: f64, albedo: f64, g: f64, pivot: Option<DVec2>,
+        point: DVec2, direction: DVec2, normal: DVec2);
+
+    #[derive(Clone, Copy, Serialize, Deserialize)]
+    #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+    pub enum Surface {
+        Emitter {
+            #[serde(deserialize_with = "radiance")]
+            radiance: f64,
+        },
+        Absorber {},
+        Reflector {
+            #[serde(deserialize_with = "albedo")]
+            albedo: f64,
+        },
+        Transparent {},
+    }
+
+    impl From<Surface> for super::Surface {
+        fn from(s: Surface) -> Self {
+            match s {
+                Surface::Emitter { radiance } => Self::Emitter { radiance },
+                Surface::Absorber {} => Self::Absorber,
+                Surface::Reflector { albedo } => Self::Reflector { albedo },
+                Surface::Transparent {} => Self::Transparent,
+            }
+        }
+    }
+
+    impl From<super::Surface> for Surface {
+        fn from(s: super::Surface) -> Self {
+            match s {
+                super::Surface::Emitter { radiance } => Self::Emitter { radiance },
+                super::Surface::Absorber => Self::Absorber {},
+                super::Surface::Reflector { albedo } => Self::Reflector { albedo },
+                super::Surface::Transparent => Self::Transparent {},
+            }
+        }
+    }
+
+    #[derive(Clone, Copy, Serialize, Deserialize)]
+    #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+    pub enum Phase {
+        Isotropic {},
+        HenyeyGreenstein {
+            #[serde(deserialize_with = "g")]
+            g: f64,
+        },
+    }
+
+    impl From<Phase> for super::Phase {
+        fn from(p: Phase) -> Self {
+            match p {
+                Phase::Isotropic {} => Self::Isotropic,
+                Phase::HenyeyGreenstein { g } => Self::HenyeyGreenstein { g },
+            }
+        }
+    }
+
+    impl From<super::Phase> for Phase {
+        fn from(p: super::Phase) -> Self {
+            match p {
+                super::Phase::Isotropic => Self::Isotropic {},
+                super::Phase::HenyeyGreenstein { g } => Self::HenyeyGreenstein { g },
+            }
+        }
+    }
+
+    #[derive(Clone, Copy, Serialize, Deserialize)]
+    #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+    pub enum Motion {
+        TranslateX {},
+        TranslateY {},
+        Rotate {
+            #[serde(
+                default,
+                deserialize_with = "pivot",
+                skip_serializing_if = "Option::is_none"
+            )]
+            pivot: Option<DVec2>,
+        },
+        Scale {
+            #[serde(
+                default,
+                deserialize_with = "pivot",
+                skip_serializing_if = "Option::is_none"
+            )]
+            pivot: Option<DVec2>,
+        },
+    }
+
+    impl From<Motion> for super::Motion {
+        fn from(m: Motion) -> Self {
+            match m {
+                Motion::TranslateX {} => Self::TranslateX,
+                Motion::TranslateY {} => Self::TranslateY,
+                Motion::Rotate { pivot } => Self::Rotate { pivot },
+                Motion::Scale { pivot } => Self::Scale { pivot },
+            }
+        }
+    }
+
+    impl From<super::Motion> for Motion {
+        fn from(m: super::Motion) -> Self {
+            match m {
+                super::Motion::TranslateX => Self::TranslateX {},
+                super::Motion::TranslateY => Self::TranslateY {},
+                super::Motion::Rotate { pivot } => Self::Rotate { pivot },
+                super::Motion::Scale { pivot } => Self::Scale { pivot },
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,187 @@
+//! Scene files: a flatland [`Scene`] written as TOML or JSON.
+//!
+//! A file holds the shapes, the parameters (optional) and the sensor, spelt
+//! as the serde forms of [`Shape`], [`Parameter`] and [`Sensor`]
+//! (points are `[x, y]`). In TOML:
+//!
+//! ```toml
+//! [sensor]
+//! kind = "irradiance"
+//! point = [0.0, 0.0]
+//! normal = [0.0, 1.0]
+//!
+//! [[shapes]]
+//! name = "lamp"
+//! vertices = [[-1.0, 2.0], [1.0, 2.0]]
+//! surface = { kind = "emitter", radiance = 1.0 }
+//!
+//! [[shapes]]
+//! name = "occluder"
+//! vertices = [[-0.6, 1.0], [0.2, 1.0]]
+//! surface = { kind = "absorber" }
+//!
+//! [[parameters]]
+//! name = "occluder_tx"
+//! shape = "occluder"
+//! motion = { kind = "translate_x" }
+//! ```
+//!
+//! Unknown fields are errors, and so is everything [`Scene::new`] rejects.
+//! Every error is an [`Error::Scene`] that names the file (for [`load`]), and
+//! for a parse error the line, the column and the field at fault.
+use super::scene::{Parameter, Scene, Sensor, Shape};
+use crate::error::Error;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The contents of a scene file: [`Scene::new`]'s arguments.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// The shapes, in order.
+    pub shapes: Vec<Shape>,
+    /// The parameters whose sensitivities are wanted (none if absent).
+    #[serde(default)]
+    pub parameters: Vec<Parameter>,
+    /// What is measured.
+    pub sensor: Sensor,
+}
+
+impl SceneFile {
+    /// The file form of a scene (pivots resolved, sensor vectors normalised).
+    pub fn of(scene: &Scene) -> SceneFile {
+        SceneFile {
+            shapes: scene.shapes().to_vec(),
+            parameters: scene.parameters().to_vec(),
+            sensor: scene.sensor(),
+        }
+    }
+
+    /// Validates the contents into a scene.
+    pub fn into_scene(self) -> Result<Scene, Error> {
+        Scene::new(self.shapes, self.parameters, self.sensor)
+    }
+}
+
+/// Reads the scene file at `path`: TOML if it ends in `.toml`, JSON if in
+/// `.json` (any case). Errors name the file.
+pub fn load(path: &Path) -> Result<Scene, Error> {
+    let in_file = |e: Error| match e {
+        Error::Scene(msg) => Error::Scene(format!("{}: {msg}", path.display())),
+        other => other,
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let parse: fn(&str) -> Result<Scene, Error> = match ext.as_deref() {
+        Some("toml") => from_toml,
+        Some("json") => from_json,
+        _ => {
+            return Err(Error::Scene(format!(
+                "{}: unknown scene file extension {:?}: expected .toml or .json",
+                path.display(),
+                path.extension().unwrap_or_default()
+            )));
+        }
+    };
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::Scene(format!("cannot read scene file {}: {e}", path.display())))?;
+    parse(&text).map_err(in_file)
+}
+
+/// Parses and validates a TOML scene.
+pub fn from_toml(text: &str) -> Result<Scene, Error> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| {
+        // toml's message starts with "TOML parse error at line L, column C"
+        // and shows the line with the key or value at fault.
+        Error::Scene(e.to_string().trim_end().to_string())
+    })?;
+    file.into_scene()
+}
+
+/// Parses and validates a JSON scene.
+pub fn from_json(text: &str) -> Result<Scene, Error> {
+    let file: SceneFile = serde_json::from_str(text).map_err(|e| json_error(text, &e))?;
+    file.into_scene()
+}
+
+/// The TOML text of a scene; [`from_toml`] reads it back to the same shapes,
+/// parameters and sensor.
+pub fn to_toml(scene: &Scene) -> String {
+    toml::to_string(&SceneFile::of(scene))
+        .expect("a validated scene has finite numbers and string keys")
+}
+
+/// serde_json's message (which ends "at line L column C"), preceded by the
+/// key being read there when the message names no field (a wrong type, an
+/// unknown variant).
+fn json_error(text: &str, e: &serde_json::Error) -> Error {
+    let msg = e.to_string();
+    let names_field = msg.contains("field `");
+    let key = (e.classify() == serde_json::error::Category::Data && !names_field && e.line() > 0)
+        .then(|| key_before(text, e.line(), e.column()))
+        .flatten();
+    match key {
+        Some(key) => Error::Scene(format!("JSON: field `{key}`: {msg}")),
+        None => Error::Scene(format!("JSON: {msg}")),
+    }
+}
+
+/// The last object key (`"name":`) written before line `line`, column
+/// `column` (both from 1), if any. None at the end of an object: serde_json
+/// reports there the errors of a buffered (internally tagged) object, whose
+/// last key need not be the one at fault.
+fn key_before(text: &str, line: usize, column: usize) -> Option<String> {
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line - 1)
+        .map(str::len)
+        .sum();
+    let rest = &text[start..];
+    let upto = rest
+        .char_indices()
+        .nth(column)
+        .map_or(rest.len(), |(i, _)| i);
+    let prefix = &text[..start + upto];
+    if prefix.trim_end().ends_with('}') {
+        return None;
+    }
+    // Scan strings left to right; remember each string followed by ':'.
+    let bytes = prefix.as_bytes();
+    let mut key = None;
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'"' {
+            let open = i + 1;
+            i += 1;
+            while i < bytes.len() && bytes[i] != b'"' {
+                i += if bytes[i] == b'\\' { 2 } else { 1 };
+            }
+            let close = i.min(bytes.len());
+            let mut j = i + 1;
+            while j < bytes.len() && bytes[j].is_ascii_whitespace() {
+                j += 1;
+            }
+            if j < bytes.len() && bytes[j] == b':' {
+                key = Some(prefix[open..close].to_string());
+            }
+        }
+        i += 1;
+    }
+    key
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_json_key_before_an_error_is_found() {
+        let text = "{\n  \"a\": 1,\n  \"b\": \"x\"\n}";
+        assert_eq!(key_before(text, 3, 10).as_deref(), Some("b"));
+        assert_eq!(key_before(text, 2, 8).as_deref(), Some("a"));
+        assert_eq!(key_before(text, 1, 1), None);
+        assert_eq!(key_before(text, 4, 1), None);
+    }
+}
