@@ -116,7 +116,13 @@ fn main() {
         println!();
         return;
     }
-    for m in [Method::Intensity, Method::Fd, Method::Rendering, Method::Expectation, Method::Transport] {
+    for m in [
+        Method::Intensity,
+        Method::Fd,
+        Method::Rendering,
+        Method::Expectation,
+        Method::Transport,
+    ] {
         let e = m.estimator(scene.clone()).unwrap();
         let r = run(e.as_ref(), &RunConfig::new(n, 3).unwrap()).unwrap();
         print!("{:<12} {:6.2}s", m.name(), r.seconds);

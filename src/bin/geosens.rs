@@ -39,6 +39,41 @@ enum Command {
     /// Compare the four methods with the exact solution on the paper's rods,
     /// then write the rod's figures.
     Compare(CompareArgs),
+    /// Estimate I and ∂I/∂π for every parameter of a flatland scene file.
+    Flat(FlatArgs),
+}
+
+/// `geosens flat`: a scene file, a method, a run.
+#[derive(Debug, Args)]
+struct FlatArgs {
+    /// Scene file (TOML or JSON; see scenes/).
+    #[arg(long)]
+    scene: std::path::PathBuf,
+    /// Estimation method.
+    #[arg(long, value_enum)]
+    method: FlatMethod,
+    /// The run configuration.
+    #[command(flatten)]
+    run: RunArgs,
+    /// Print one JSON line instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `--method` of `geosens flat`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum FlatMethod {
+    /// Backward path tracing of I only.
+    Intensity,
+    /// Expectation differentiation (warp field): I and s from the same paths.
+    Expectation,
+    /// Differentiable rendering: corner and medium-boundary terms by double
+    /// randomization.
+    Rendering,
+    /// Sensitivity transport, with ∂I/∂x and ∂I/∂y at the sensor.
+    Transport,
+    /// Central finite differences with common random numbers.
+    Fd,
 }
 
 /// How to estimate: the method, the rod, the probe and the run. Float values
@@ -435,12 +470,124 @@ fn compare_command(
     Ok(())
 }
 
+/// The one JSON line of `geosens flat --json`: the rod's shape, with one
+/// sensitivity per parameter.
+#[derive(Serialize)]
+struct FlatJsonLine<'a> {
+    /// Method name.
+    method: &'a str,
+    /// The sensor's reading.
+    intensity: MeanErr,
+    /// `∂I/∂π` keyed by parameter name (declaration order).
+    sensitivity: serde_json::Map<String, serde_json::Value>,
+    /// `∂I/∂x`, `∂I/∂y` at the sensor (`transport` only).
+    gradient: Option<serde_json::Map<String, serde_json::Value>>,
+    /// Paths sampled.
+    paths: u64,
+    /// Wall time of the sampling, in seconds.
+    seconds: f64,
+}
+
+/// `geosens flat`.
+fn flat_command(args: &FlatArgs, out: &mut impl Write) -> Result<(), Box<dyn std::error::Error>> {
+    use geosens::flat::{Method as Flat, file};
+    let scene = std::sync::Arc::new(file::load(&args.scene)?);
+    let method = match args.method {
+        FlatMethod::Intensity => Flat::Intensity,
+        FlatMethod::Expectation => Flat::Expectation,
+        FlatMethod::Rendering => Flat::Rendering,
+        FlatMethod::Transport => Flat::Transport,
+        FlatMethod::Fd => Flat::Fd,
+    };
+    let cfg = args.run.config(1_000_000)?;
+    let result = run(method.estimator(scene.clone())?.as_ref(), &cfg)?;
+    if let Some((q, e)) = result
+        .estimates
+        .iter()
+        .find(|(_, e)| !(e.mean.is_finite() && e.stderr.is_finite()))
+    {
+        return Err(format!(
+            "method {} gives {q} = {} ± {} (floating-point overflow)",
+            result.method, e.mean, e.stderr
+        )
+        .into());
+    }
+    if args.json {
+        let value = |e: &Estimate| {
+            serde_json::to_value(MeanErr {
+                mean: e.mean,
+                stderr: e.stderr,
+            })
+        };
+        let mut intensity = None;
+        let mut sensitivity = serde_json::Map::new();
+        let mut gradient = serde_json::Map::new();
+        for (q, e) in &result.estimates {
+            match q {
+                Quantity::Intensity => {
+                    intensity = Some(MeanErr {
+                        mean: e.mean,
+                        stderr: e.stderr,
+                    })
+                }
+                Quantity::Sensitivity(p) => {
+                    sensitivity.insert(p.clone(), value(e)?);
+                }
+                Quantity::Gradient(a) => {
+                    gradient.insert(a.clone(), value(e)?);
+                }
+            }
+        }
+        let line = FlatJsonLine {
+            method: result.method,
+            intensity: intensity.ok_or("no intensity estimate")?,
+            sensitivity,
+            gradient: (!gradient.is_empty()).then_some(gradient),
+            paths: result.paths,
+            seconds: result.seconds,
+        };
+        writeln!(out, "{}", serde_json::to_string(&line)?)?;
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "scene {}: {} shapes, {} parameters",
+        args.scene.display(),
+        scene.shapes().len(),
+        scene.parameters().len()
+    )?;
+    writeln!(
+        out,
+        "method {}: {} paths, seed {}, {:.3} s",
+        result.method, result.paths, cfg.seed, result.seconds
+    )?;
+    writeln!(
+        out,
+        "{:<20} {:>14} {:>11} {:>9} {:>9} {:>8}",
+        "quantity", "mean", "stderr", "vov", "max_share", "reliable"
+    )?;
+    for (q, e) in &result.estimates {
+        writeln!(
+            out,
+            "{:<20} {:>14.6e} {:>11.2e} {:>9.1e} {:>9.1e} {:>8}",
+            q.to_string(),
+            e.mean,
+            e.stderr,
+            e.vov,
+            e.max_share,
+            yes_no(e.is_reliable())
+        )?;
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let mut out = io::stdout().lock();
     let result = match &cli.command {
         Command::Rod(args) => rod_command(args, &mut out),
         Command::Compare(args) => compare_command(args, &mut out),
+        Command::Flat(args) => flat_command(args, &mut out),
     };
     match result.and_then(|()| Ok(out.flush()?)) {
         Ok(()) => ExitCode::SUCCESS,

@@ -650,6 +650,101 @@ impl AbsorbedIrradiance {
     }
 }
 
+/// The analytic reference of a whole [`Scene`](super::Scene), where one
+/// exists: an irradiance sensor, one emitter segment, black absorbers, and at
+/// most one purely absorbing medium (κs = 0), nothing else. `I` and every
+/// parameter's `∂I/∂π` in closed form or by quadrature.
+pub struct Reference {
+    kind: ReferenceKind,
+    /// Per scene parameter: the reference shape it moves and how.
+    moves: Vec<(ShapeId, Motion)>,
+}
+
+enum ReferenceKind {
+    Occluded(OccludedIrradiance),
+    Absorbed(AbsorbedIrradiance),
+}
+
+impl Reference {
+    /// The reference for `scene`, or an error saying why it has none.
+    pub fn for_scene(scene: &super::Scene) -> Result<Reference, Error> {
+        use super::scene::{Motion as SceneMotion, Sensor, Surface};
+        let unsupported = |why: &str| Err(Error::Scene(format!("no analytic reference: {why}")));
+        let Sensor::Irradiance { point, normal } = scene.sensor() else {
+            return unsupported("the sensor measures radiance");
+        };
+        let mut emitter = None;
+        let mut occluders = Vec::new();
+        let mut medium = None;
+        let mut ids = Vec::new();
+        for s in scene.shapes() {
+            let id = match (s.surface, s.medium) {
+                (Surface::Emitter { radiance }, _) => {
+                    if emitter.is_some() || s.vertices.len() != 2 {
+                        return unsupported("the emitter must be one segment");
+                    }
+                    emitter = Some(Emitter::new(s.vertices[0], s.vertices[1], radiance)?);
+                    ShapeId::Emitter
+                }
+                (Surface::Absorber, _) => {
+                    occluders.push(if s.closed {
+                        Shape::polygon(s.vertices.clone())?
+                    } else {
+                        Shape::polyline(s.vertices.clone())?
+                    });
+                    ShapeId::Occluder(occluders.len() - 1)
+                }
+                (Surface::Transparent, Some(m)) if m.ks == 0.0 && medium.is_none() => {
+                    medium = Some((Shape::polygon(s.vertices.clone())?, m.ke));
+                    ShapeId::Medium
+                }
+                _ => return unsupported("reflectors, scattering media or several media"),
+            };
+            ids.push(id);
+        }
+        let Some(emitter) = emitter else {
+            return unsupported("no emitter");
+        };
+        let view = OccludedIrradiance::new(point, normal, emitter, occluders)?;
+        let kind = match medium {
+            Some((shape, ke)) => ReferenceKind::Absorbed(AbsorbedIrradiance::new(view, shape, ke)?),
+            None => ReferenceKind::Occluded(view),
+        };
+        let moves = (0..scene.parameters().len())
+            .map(|j| {
+                let p = &scene.parameters()[j];
+                let id = ids[scene.parameter_shape(j) as usize];
+                let pivot = |c: Option<DVec2>| c.unwrap_or(DVec2::ZERO);
+                let motion = match p.motion {
+                    SceneMotion::TranslateX => Motion::TranslateX,
+                    SceneMotion::TranslateY => Motion::TranslateY,
+                    SceneMotion::Rotate { pivot: c } => Motion::Rotate { pivot: pivot(c) },
+                    SceneMotion::Scale { pivot: c } => Motion::Scale { pivot: pivot(c) },
+                };
+                (id, motion)
+            })
+            .collect();
+        Ok(Reference { kind, moves })
+    }
+
+    /// The irradiance `E`.
+    pub fn value(&self) -> f64 {
+        match &self.kind {
+            ReferenceKind::Occluded(r) => r.value(),
+            ReferenceKind::Absorbed(r) => r.value(),
+        }
+    }
+
+    /// `∂E/∂π_j` for the scene's parameter `j`.
+    pub fn derivative(&self, j: usize) -> f64 {
+        let (id, motion) = self.moves[j];
+        match &self.kind {
+            ReferenceKind::Occluded(r) => r.derivative_of(id, motion),
+            ReferenceKind::Absorbed(r) => r.derivative_of(id, motion),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -455,8 +455,7 @@ impl Walk<'_> {
                                 d.u[j] = DVec2::ZERO;
                             }
                         }
-                        self.frozen()
-                            .trace(rng, &mut g, n, x, w, medium, skip, 1.0);
+                        self.frozen().trace(rng, &mut g, n, x, w, medium, skip, 1.0);
                         for j in 0..n {
                             if self.rule(j) == Rule::Euler {
                                 d.boundary[j] += beta * lobe.weight() * g.boundary[j];

@@ -1,0 +1,166 @@
+//! Every flatland estimator against an independent reference, within 4
+//! standard errors at fixed seeds: the closed-form irradiance behind moving
+//! occluders and the quadrature through an absorbing slab
+//! (`flat::exact`), and, for scattering media and reflectors, central
+//! finite differences with common random numbers at a larger step and a
+//! higher path count (their O(h²) bias is checked to be under the bound).
+use geosens::flat::exact::Reference;
+use geosens::flat::methods::FiniteDifference;
+use geosens::flat::{Method, Scene, file};
+use geosens::{Estimate, Quantity, RunConfig, RunResult, run};
+use std::path::Path;
+use std::sync::Arc;
+
+const DERIVATIVE_METHODS: [Method; 4] = [
+    Method::Rendering,
+    Method::Expectation,
+    Method::Transport,
+    Method::Fd,
+];
+
+fn scene(name: &str) -> Arc<Scene> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    Arc::new(file::load(&path).unwrap())
+}
+
+fn estimate(method: Method, scene: &Arc<Scene>, paths: u64, seed: u64) -> RunResult {
+    let e = method.estimator(scene.clone()).unwrap();
+    run(e.as_ref(), &RunConfig::new(paths, seed).unwrap()).unwrap()
+}
+
+/// The estimate of `I` (`j = None`) or of parameter `j`'s sensitivity.
+fn get(r: &RunResult, scene: &Scene, j: Option<usize>) -> Estimate {
+    let q = match j {
+        None => Quantity::Intensity,
+        Some(j) => Quantity::sensitivity(&scene.parameters()[j].name),
+    };
+    r.get(&q).unwrap()
+}
+
+/// Every method's `I` and `∂I/∂π` against the analytic reference.
+fn against_reference(name: &str, paths: u64) {
+    let scene = scene(name);
+    let reference = Reference::for_scene(&scene).unwrap();
+    for (seed, method) in DERIVATIVE_METHODS.into_iter().enumerate() {
+        let r = estimate(method, &scene, paths, 11 + seed as u64);
+        for j in std::iter::once(None).chain((0..scene.parameters().len()).map(Some)) {
+            let e = get(&r, &scene, j);
+            let exact = j.map_or(reference.value(), |j| reference.derivative(j));
+            let z = e.z_score(exact);
+            eprintln!(
+                "{name} {} {j:?}: {:.5} ± {:.5} vs exact {exact:.5}, z = {z:.2}",
+                method.name(),
+                e.mean,
+                e.stderr
+            );
+            assert!(
+                e.stderr > 0.0 && z < 4.0,
+                "{name} {} {j:?}: {} ± {} vs exact {exact} (z = {z:.2})",
+                method.name(),
+                e.mean,
+                e.stderr
+            );
+        }
+    }
+}
+
+#[test]
+fn segment_occluder_matches_the_closed_form() {
+    against_reference("occluder.toml", 400_000);
+}
+
+#[test]
+fn polygon_occluder_matches_the_closed_form() {
+    against_reference("polygon_occluder.toml", 400_000);
+}
+
+#[test]
+fn absorbing_slab_matches_the_quadrature() {
+    against_reference("absorbing_slab.toml", 400_000);
+}
+
+#[test]
+fn the_intensity_estimator_matches_the_closed_form() {
+    for name in [
+        "occluder.toml",
+        "polygon_occluder.toml",
+        "absorbing_slab.toml",
+    ] {
+        let scene = scene(name);
+        let exact = Reference::for_scene(&scene).unwrap().value();
+        let e = get(
+            &estimate(Method::Intensity, &scene, 400_000, 5),
+            &scene,
+            None,
+        );
+        assert!(e.z_score(exact) < 4.0, "{name}: {e:?} vs {exact}");
+    }
+}
+
+/// Scenes without a closed form: every method against CRN finite
+/// differences with a 10× larger step at `fd_paths`.
+fn against_finite_differences(name: &str, paths: u64, fd_paths: u64) {
+    let scene = scene(name);
+    let fd = FiniteDifference::new(scene.clone(), 1e-2).unwrap();
+    let reference = run(&fd, &RunConfig::new(fd_paths, 99).unwrap()).unwrap();
+    for (seed, method) in [Method::Rendering, Method::Expectation, Method::Transport]
+        .into_iter()
+        .enumerate()
+    {
+        let r = estimate(method, &scene, paths, 21 + seed as u64);
+        for j in std::iter::once(None).chain((0..scene.parameters().len()).map(Some)) {
+            let (e, f) = (get(&r, &scene, j), get(&reference, &scene, j));
+            let z = (e.mean - f.mean).abs() / (e.stderr.powi(2) + f.stderr.powi(2)).sqrt();
+            eprintln!(
+                "{name} {} {j:?}: {:.5} ± {:.5} vs fd {:.5} ± {:.5}, z = {z:.2}",
+                method.name(),
+                e.mean,
+                e.stderr,
+                f.mean,
+                f.stderr
+            );
+            assert!(
+                e.stderr > 0.0 && z < 4.0,
+                "{name} {} {j:?}: {} ± {} vs finite differences {} ± {} (z = {z:.2})",
+                method.name(),
+                e.mean,
+                e.stderr,
+                f.mean,
+                f.stderr
+            );
+        }
+    }
+}
+
+#[test]
+fn fog_matches_finite_differences() {
+    against_finite_differences("fog.toml", 400_000, 2_000_000);
+}
+
+#[test]
+fn reflector_matches_finite_differences() {
+    against_finite_differences("reflector.toml", 400_000, 2_000_000);
+}
+
+#[test]
+fn radiance_through_fog_matches_finite_differences() {
+    against_finite_differences("radiance.toml", 400_000, 2_000_000);
+}
+
+#[test]
+fn three_shapes_match_finite_differences() {
+    against_finite_differences("three_shapes.toml", 200_000, 1_000_000);
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let scene = scene("three_shapes.toml");
+    for method in DERIVATIVE_METHODS {
+        let e = method.estimator(scene.clone()).unwrap();
+        let one = run(e.as_ref(), &RunConfig::new(9_000, 3).unwrap().threads(1)).unwrap();
+        let two = run(e.as_ref(), &RunConfig::new(9_000, 3).unwrap().threads(2)).unwrap();
+        assert_eq!(one.estimates, two.estimates, "{}", method.name());
+    }
+}
