@@ -198,3 +198,26 @@ impl Estimator for FiniteDifference {
         }
     }
 }
+
+/// The expectation method's warp field at the sensor: `V_j(φ)` (rad per
+/// unit of parameter `j`) of the looking direction at angle `phi` from +x,
+/// for every parameter. For an irradiance sensor, directions behind it get
+/// 0 (the field is pinned to the frame at the horizons).
+pub fn sensor_warp(scene: &Scene, phi: f64) -> Vec<f64> {
+    let slots = Slots::new(scene, false);
+    let mut out = vec![0.0; slots.len()];
+    let w = super::geometry::direction(phi);
+    if let Sensor::Irradiance { normal, .. } = scene.sensor()
+        && w.dot(normal) <= 0.0
+    {
+        return out;
+    }
+    Walk {
+        scene,
+        slots: &slots,
+        scheme: Scheme::Expectation,
+        frozen: false,
+    }
+    .sensor_warp(w, &mut out);
+    out
+}

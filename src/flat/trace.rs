@@ -100,13 +100,29 @@ pub(crate) fn survives(depth: u32, beta: &mut f64, rng: &mut PathRng) -> bool {
 /// One-sample estimate of the radiance arriving at `x` from direction `w`
 /// (the path travels along `w`), `x` lying in `medium`, leaving segment
 /// `skip` (or [`NO_SEGMENT`]).
+#[inline]
 pub fn radiance(
+    scene: &Scene,
+    rng: &mut PathRng,
+    x: DVec2,
+    w: DVec2,
+    medium: Option<u32>,
+    skip: u32,
+) -> f64 {
+    radiance_observed(scene, rng, x, w, medium, skip, &mut |_| {})
+}
+
+/// [`radiance`], calling `vertex` at every scattering, reflection or
+/// crossing point and at the end of the path (figures draw paths with it;
+/// the no-op observer compiles away).
+pub fn radiance_observed(
     scene: &Scene,
     rng: &mut PathRng,
     mut x: DVec2,
     mut w: DVec2,
     mut medium: Option<u32>,
     mut skip: u32,
+    vertex: &mut impl FnMut(DVec2),
 ) -> f64 {
     let mut beta = 1.0;
     let mut depth = 0;
@@ -119,6 +135,7 @@ pub fn radiance(
             if xi < t_b {
                 beta *= (-ka * xi).exp();
                 x += xi * w;
+                vertex(x);
                 w = phase_direction(m.phase, w, rng);
                 skip = NO_SEGMENT;
                 depth += 1;
@@ -129,8 +146,13 @@ pub fn radiance(
             }
             beta *= (-ka * t_b).exp();
         }
-        let Some(h) = hit else { return 0.0 };
+        let Some(h) = hit else {
+            // Leaving the scene: the path's last leg, cut at the scene's size.
+            vertex(x + 2.0 * scene.size() * w);
+            return 0.0;
+        };
         x += h.t * w;
+        vertex(x);
         skip = h.segment;
         let k = scene.owner(h.segment);
         match scene.shapes()[k as usize].surface {

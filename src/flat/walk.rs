@@ -478,6 +478,28 @@ impl Walk<'_> {
         intensity
     }
 
+    /// The expectation method's warp at the irradiance sensor: the angular
+    /// velocity `V_j(φ)` of direction `w` for every slot (figures, tests).
+    pub(crate) fn sensor_warp(&self, w: DVec2, out: &mut [f64]) {
+        let n = self.slots.len();
+        let mut d = Deriv::new();
+        let (x, lobe) = match self.scene.sensor() {
+            Sensor::Irradiance { point, normal } => (point, Lobe::Cosine { n: normal, c: 1.0 }),
+            Sensor::Radiance { point, direction } => (
+                point,
+                Lobe::Phase {
+                    phase: Phase::Isotropic,
+                    w_in: direction,
+                },
+            ),
+        };
+        for j in 0..n {
+            d.u[j] = self.slots.sensor_velocity(j);
+        }
+        self.warp(&mut d, n, x, NO_SEGMENT, &lobe, &[0.0; MAX_SLOTS], w);
+        out[..n].copy_from_slice(&d.phid[..n]);
+    }
+
     /// The same walk in the frozen scene, rendering rules for every slot.
     fn frozen(&self) -> Walk<'_> {
         Walk {
@@ -673,6 +695,7 @@ impl Walk<'_> {
     /// The warp at `x` for the sampled direction `w`: the nearest visible
     /// corner (or horizon) on each side are the knots; the field is linear
     /// in angle between them.
+    #[allow(clippy::too_many_arguments)]
     fn warp(
         &self,
         d: &mut Deriv,
