@@ -69,6 +69,9 @@ pub(crate) struct Slots {
     pub gradient: bool,
     /// Indices (into `scene.corners()`) of the corners of moving shapes.
     pub moving_corners: Vec<u32>,
+    /// The corners visible from an irradiance sensor in front of it, by
+    /// angle from +x: the warp's knots there, the same for every path.
+    pub sensor_knots: Vec<Knot>,
 }
 
 impl Slots {
@@ -82,10 +85,22 @@ impl Slots {
             .filter(|(_, c)| moving(c.1))
             .map(|(i, _)| i as u32)
             .collect();
+        let mut sensor_knots: Vec<Knot> = match scene.sensor() {
+            Sensor::Irradiance { point, normal } => scene
+                .corners()
+                .iter()
+                .filter(|&&(q, _)| (q - point).dot(normal) > 0.0)
+                .filter(|&&(q, _)| scene.visible(point, q, NO_SEGMENT))
+                .map(|&(q, k)| ((q - point).y.atan2((q - point).x), q, k))
+                .collect(),
+            Sensor::Radiance { .. } => Vec::new(),
+        };
+        sensor_knots.sort_by(|a, b| a.0.total_cmp(&b.0));
         Slots {
             params,
             gradient,
             moving_corners,
+            sensor_knots,
         }
     }
 
@@ -193,6 +208,17 @@ impl Lobe {
     }
 }
 
+/// A knot of the warp: angle from the sampled direction, corner, shape.
+type Knot = (f64, DVec2, u32);
+
+/// A monotone stand-in for the counter-clockwise angle in `[0, 4)` of a
+/// vector with cosine part `c` and sine part `s` relative to a direction.
+#[inline]
+fn pseudo_angle(c: f64, s: f64) -> f64 {
+    let t = c / (c.abs() + s.abs());
+    if s >= 0.0 { 1.0 - t } else { 3.0 + t }
+}
+
 /// Per-slot state of a walk.
 struct Deriv {
     /// Vertex velocity `∂x/∂π_j`.
@@ -285,7 +311,9 @@ impl Walk<'_> {
             Sensor::Irradiance { normal, .. } => {
                 let lobe = Lobe::Cosine { n: normal, c: 1.0 };
                 let fixed = [0.0; MAX_SLOTS];
-                let w = self.directions(rng, &mut d, n, x, medium, NO_SEGMENT, &lobe, &fixed, 1.0);
+                let w = self.directions(
+                    rng, &mut d, n, x, medium, NO_SEGMENT, &lobe, &fixed, 1.0, true,
+                );
                 (w, lobe.weight())
             }
         };
@@ -367,7 +395,7 @@ impl Walk<'_> {
                         w_in: w,
                     };
                     let spin = d.phid;
-                    w = self.directions(rng, d, n, x, medium, skip, &lobe, &spin, beta);
+                    w = self.directions(rng, d, n, x, medium, skip, &lobe, &spin, beta, false);
                     depth += 1;
                     if !survives(depth, &mut beta, rng) {
                         break;
@@ -442,7 +470,7 @@ impl Walk<'_> {
                             }
                         }
                     }
-                    w = self.directions(rng, d, n, x, medium, skip, &lobe, &spin, beta);
+                    w = self.directions(rng, d, n, x, medium, skip, &lobe, &spin, beta, false);
                     if moving {
                         // … and its regular part: the radiance reflected at
                         // the moving point in the turning frame, by a
@@ -496,7 +524,17 @@ impl Walk<'_> {
         for j in 0..n {
             d.u[j] = self.slots.sensor_velocity(j);
         }
-        self.warp(&mut d, n, x, NO_SEGMENT, &lobe, &[0.0; MAX_SLOTS], w);
+        let at_sensor = matches!(self.scene.sensor(), Sensor::Irradiance { .. });
+        self.warp(
+            &mut d,
+            n,
+            x,
+            NO_SEGMENT,
+            &lobe,
+            &[0.0; MAX_SLOTS],
+            w,
+            at_sensor,
+        );
         out[..n].copy_from_slice(&d.phid[..n]);
     }
 
@@ -597,6 +635,7 @@ impl Walk<'_> {
         lobe: &Lobe,
         spin: &[f64; MAX_SLOTS],
         beta: f64,
+        at_sensor: bool,
     ) -> DVec2 {
         match self.scheme {
             Scheme::Rendering | Scheme::Transport => {
@@ -607,7 +646,7 @@ impl Walk<'_> {
             }
             Scheme::Expectation => {
                 let w = lobe.sample(rng);
-                self.warp(d, n, x, skip, lobe, spin, w);
+                self.warp(d, n, x, skip, lobe, spin, w, at_sensor);
                 w
             }
         }
@@ -705,10 +744,14 @@ impl Walk<'_> {
         lobe: &Lobe,
         spin: &[f64; MAX_SLOTS],
         w: DVec2,
+        at_sensor: bool,
     ) {
         let (h_ccw, h_cw) = lobe.horizons(w);
-        let ccw = self.nearest_visible_corner(x, skip, lobe, w, h_ccw, true);
-        let cw = self.nearest_visible_corner(x, skip, lobe, w, h_cw, false);
+        let (ccw, cw) = if at_sensor {
+            self.sensor_knots(w, (h_ccw, h_cw))
+        } else {
+            self.nearest_knots(x, skip, w, (h_ccw, h_cw))
+        };
         let slope_log = lobe.log_slope(w);
         for j in 0..n {
             // Knot values: a corner's angular velocity, or the frame's at a
@@ -729,42 +772,106 @@ impl Walk<'_> {
         }
     }
 
-    /// The visible corner nearest to `w` turning counter-clockwise (`ccw`)
-    /// or clockwise, closer than `limit` radians and inside the lobe:
-    /// `(angle, corner, shape)`.
-    fn nearest_visible_corner(
+    /// The visible corners nearest to `w` counter-clockwise and clockwise,
+    /// closer than the lobe's horizons `(h_ccw, h_cw)` radians: `(angle,
+    /// corner, shape)` each. One pass orders the corners by a pseudo-angle
+    /// (monotone in the angle, no trigonometry); only the winners get a
+    /// shadow ray, and a hidden winner makes its side scan again past it.
+    fn nearest_knots(
         &self,
         x: DVec2,
         skip: u32,
-        lobe: &Lobe,
         w: DVec2,
-        limit: f64,
-        ccw: bool,
-    ) -> Option<(f64, DVec2, u32)> {
+        (h_ccw, h_cw): (f64, f64),
+    ) -> (Option<Knot>, Option<Knot>) {
         let scene = self.scene;
-        let mut bound = 0.0;
-        loop {
-            let mut best: Option<(f64, DVec2, u32)> = None;
-            let mut best_angle = limit;
-            for &(q, k) in scene.corners() {
+        let corners = scene.corners();
+        let limit = |h: f64| {
+            if h >= std::f64::consts::TAU {
+                4.0
+            } else {
+                let (s, c) = h.sin_cos();
+                pseudo_angle(c, s)
+            }
+        };
+        let (lim_ccw, lim_cw) = (limit(h_ccw), limit(h_cw));
+        let (mut bound_ccw, mut bound_cw) = (0.0, 0.0);
+        let (mut done_ccw, mut done_cw) = (false, false);
+        let (mut ccw, mut cw) = (None, None);
+        while !(done_ccw && done_cw) {
+            let (mut best_ccw, mut best_cw) = (lim_ccw, lim_cw);
+            let (mut i_ccw, mut i_cw) = (usize::MAX, usize::MAX);
+            for (i, &(q, _)) in corners.iter().enumerate() {
                 let r = q - x;
-                let mut a = cross(w, r).atan2(w.dot(r));
-                if !ccw {
-                    a = -a;
+                let p = pseudo_angle(w.dot(r), cross(w, r));
+                if !done_ccw && p > bound_ccw && p < best_ccw {
+                    best_ccw = p;
+                    i_ccw = i;
                 }
-                if a < 0.0 {
-                    a += 2.0 * std::f64::consts::PI;
-                }
-                if a > bound && a < best_angle && lobe.value(r.normalize()) > 0.0 {
-                    best_angle = a;
-                    best = Some((a, q, k));
+                let pc = 4.0 - p;
+                if !done_cw && pc > bound_cw && pc < best_cw {
+                    best_cw = pc;
+                    i_cw = i;
                 }
             }
-            let (a, q, _) = best?;
-            if scene.visible(x, q, skip) {
-                return best;
+            if !done_ccw {
+                if i_ccw == usize::MAX {
+                    done_ccw = true;
+                } else if scene.visible(x, corners[i_ccw].0, skip) {
+                    done_ccw = true;
+                    ccw = Some(i_ccw);
+                } else {
+                    bound_ccw = best_ccw;
+                }
             }
-            bound = a;
+            if !done_cw {
+                if i_cw == usize::MAX {
+                    done_cw = true;
+                } else if scene.visible(x, corners[i_cw].0, skip) {
+                    done_cw = true;
+                    cw = Some(i_cw);
+                } else {
+                    bound_cw = best_cw;
+                }
+            }
         }
+        let knot = |i: Option<usize>, sign: f64| {
+            i.map(|i| {
+                let (q, k) = corners[i];
+                let r = q - x;
+                let mut a = sign * cross(w, r).atan2(w.dot(r));
+                if a <= 0.0 {
+                    a += std::f64::consts::TAU;
+                }
+                (a, q, k)
+            })
+        };
+        (knot(ccw, 1.0), knot(cw, -1.0))
+    }
+
+    /// The neighbours of `w` among the sensor's knots (precomputed: the
+    /// sensor does not move).
+    fn sensor_knots(&self, w: DVec2, (h_ccw, h_cw): (f64, f64)) -> (Option<Knot>, Option<Knot>) {
+        let knots = &self.slots.sensor_knots;
+        if knots.is_empty() {
+            return (None, None);
+        }
+        let phi = w.y.atan2(w.x);
+        let i = knots.partition_point(|k| k.0 <= phi);
+        let tau = std::f64::consts::TAU;
+        let (b, b_angle) = if i < knots.len() {
+            (knots[i], knots[i].0 - phi)
+        } else {
+            (knots[0], knots[0].0 + tau - phi)
+        };
+        let (a, a_angle) = if i > 0 {
+            (knots[i - 1], phi - knots[i - 1].0)
+        } else {
+            (knots[knots.len() - 1], phi - knots[knots.len() - 1].0 + tau)
+        };
+        (
+            (b_angle < h_ccw).then_some((b_angle, b.1, b.2)),
+            (a_angle < h_cw && a_angle > 0.0).then_some((a_angle, a.1, a.2)),
+        )
     }
 }
