@@ -1,0 +1,94 @@
+//! Paths per second per thread of every flatland method, and each method's
+//! cost over the intensity's, on the occluder scene, the 3-shape scene (12
+//! parameters) and a 10⁴-segment scene (a wavy reflecting vault of 10⁴
+//! segments over the occluder scene).
+//!
+//! `cargo run --release --example flat_perf -- [ROUNDS] [PATHS]`: medians of
+//! ROUNDS (default 5) one-thread runs of PATHS paths (default 200000).
+use geosens::flat::{Method, Motion, Parameter, Scene, Sensor, Shape, Surface, file};
+use geosens::{RunConfig, run};
+use glam::DVec2;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The occluder scene under a reflecting vault of `n` segments.
+fn vault(n: usize) -> Scene {
+    let base = file::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/occluder.toml"))
+        .expect("scenes/occluder.toml loads");
+    let mut shapes = base.shapes().to_vec();
+    let vertices = (0..=n)
+        .map(|i| {
+            let a = 0.1 + (std::f64::consts::PI - 0.2) * i as f64 / n as f64;
+            let r = 3.0 + 0.05 * (40.0 * a).sin();
+            DVec2::new(r * a.cos(), r * a.sin())
+        })
+        .collect();
+    shapes.push(Shape {
+        name: "vault".into(),
+        vertices,
+        closed: false,
+        surface: Surface::Reflector { albedo: 0.5 },
+        medium: None,
+    });
+    let mut parameters: Vec<Parameter> = base.parameters().to_vec();
+    parameters.push(Parameter {
+        name: "vault_ty".into(),
+        shape: "vault".into(),
+        motion: Motion::TranslateY,
+    });
+    let sensor: Sensor = base.sensor();
+    Scene::new(shapes, parameters, sensor).expect("the vault scene is valid")
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let rounds: usize = args.next().map_or(5, |a| a.parse().expect("ROUNDS"));
+    let paths: u64 = args.next().map_or(200_000, |a| a.parse().expect("PATHS"));
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let scenes: Vec<(String, Arc<Scene>)> = vec![
+        (
+            "occluder".into(),
+            Arc::new(file::load(&dir.join("occluder.toml")).unwrap()),
+        ),
+        (
+            "three_shapes".into(),
+            Arc::new(file::load(&dir.join("three_shapes.toml")).unwrap()),
+        ),
+        ("vault 10^4".into(), Arc::new(vault(10_000))),
+    ];
+    let methods = [
+        Method::Intensity,
+        Method::Rendering,
+        Method::Expectation,
+        Method::Transport,
+        Method::Fd,
+    ];
+    println!("{rounds} rounds of {paths} paths, one thread; medians");
+    println!(
+        "{:<14} {:>4} {:<12} {:>12} {:>10}",
+        "scene", "par", "method", "paths/s", "cost/int"
+    );
+    for (name, scene) in &scenes {
+        let cfg = RunConfig::new(paths, 1).unwrap().threads(1);
+        let mut intensity = f64::NAN;
+        for m in methods {
+            let e = m.estimator(scene.clone()).unwrap();
+            let mut t: Vec<f64> = (0..rounds)
+                .map(|_| run(e.as_ref(), &cfg).unwrap().seconds)
+                .collect();
+            t.sort_by(f64::total_cmp);
+            let median = t[t.len() / 2];
+            if m == Method::Intensity {
+                intensity = median;
+            }
+            println!(
+                "{:<14} {:>4} {:<12} {:>12.3e} {:>10.2}",
+                name,
+                scene.parameters().len(),
+                m.name(),
+                paths as f64 / median,
+                median / intensity
+            );
+        }
+    }
+}

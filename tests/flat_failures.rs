@@ -1,0 +1,148 @@
+//! Where flatland methods fail, pinned: configurations in which a method's
+//! variance grows without bound (its error bar then cannot be trusted),
+//! each beside a method that stays well behaved, against the analytic
+//! reference or finite differences. The book's "Where the methods fail"
+//! section shows the same numbers.
+use geosens::flat::exact::Reference;
+use geosens::flat::{Medium, Method, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface};
+use geosens::{Estimate, Quantity, RunConfig, run};
+use glam::DVec2;
+use std::sync::Arc;
+
+fn lamp() -> Shape {
+    Shape {
+        name: "lamp".into(),
+        vertices: vec![DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0)],
+        closed: false,
+        surface: Surface::Emitter { radiance: 1.0 },
+        medium: None,
+    }
+}
+
+fn tx(shape: &str) -> Parameter {
+    Parameter {
+        name: "tx".into(),
+        shape: shape.into(),
+        motion: Motion::TranslateX,
+    }
+}
+
+fn up(point: DVec2) -> Sensor {
+    Sensor::Irradiance {
+        point,
+        normal: DVec2::Y,
+    }
+}
+
+/// `∂E/∂tx`: estimate and per-path variance `σ² N`.
+fn sensitivity(method: Method, scene: &Arc<Scene>, paths: u64) -> (Estimate, f64) {
+    let e = method.estimator(scene.clone()).unwrap();
+    let r = run(e.as_ref(), &RunConfig::new(paths, 7).unwrap()).unwrap();
+    let s = r.get(&Quantity::sensitivity("tx")).unwrap();
+    (s, s.stderr * s.stderr * paths as f64)
+}
+
+/// The occluder's left corner seen `gap` (along x at y = 1) to the right of
+/// the lamp's left end, which the sensor at the origin sees in the same
+/// direction when `gap = 0`.
+fn aligned_corners(gap: f64) -> Arc<Scene> {
+    let occluder = Shape {
+        name: "occluder".into(),
+        vertices: vec![DVec2::new(-0.5 + gap, 1.0), DVec2::new(0.2, 1.0)],
+        closed: false,
+        surface: Surface::Absorber,
+        medium: None,
+    };
+    Arc::new(
+        Scene::new(
+            vec![lamp(), occluder],
+            vec![tx("occluder")],
+            up(DVec2::ZERO),
+        )
+        .unwrap(),
+    )
+}
+
+#[test]
+fn expectation_variance_grows_as_two_warp_knots_meet() {
+    // Between two knots a radian apart the warp's slope is the difference of
+    // their velocities over their distance: its square integrates to ~1/gap.
+    let paths = 400_000;
+    let mut per_path = Vec::new();
+    for gap in [0.1, 1e-3] {
+        let scene = aligned_corners(gap);
+        let exact = Reference::for_scene(&scene).unwrap().derivative(0);
+        let (e, ve) = sensitivity(Method::Expectation, &scene, paths);
+        let (r, vr) = sensitivity(Method::Rendering, &scene, paths);
+        assert!(r.z_score(exact) < 4.0, "rendering {r:?} vs {exact}");
+        per_path.push((ve, vr, e, exact));
+    }
+    let (ve_far, vr_far, e_far, exact_far) = per_path[0];
+    let (ve_near, vr_near, _, _) = per_path[1];
+    assert!(e_far.z_score(exact_far) < 4.0, "{e_far:?} vs {exact_far}");
+    assert!(
+        ve_near > 20.0 * ve_far,
+        "expectation σ²N {ve_far:.3e} → {ve_near:.3e}"
+    );
+    assert!(
+        vr_near < 3.0 * vr_far,
+        "rendering σ²N {vr_far:.3e} → {vr_near:.3e}"
+    );
+}
+
+/// A sensor inside a moving absorbing fog, `d` from its left edge.
+fn sensor_near_moving_edge(d: f64) -> Arc<Scene> {
+    let fog = Shape {
+        name: "fog".into(),
+        vertices: vec![
+            DVec2::new(-d, -0.5),
+            DVec2::new(1.5, -0.5),
+            DVec2::new(1.5, 1.5),
+            DVec2::new(-d, 1.5),
+        ],
+        closed: true,
+        surface: Surface::Transparent,
+        medium: Some(Medium {
+            ks: 0.0,
+            ke: 1.0,
+            phase: Phase::Isotropic,
+        }),
+    };
+    Arc::new(Scene::new(vec![lamp(), fog], vec![tx("fog")], up(DVec2::ZERO)).unwrap())
+}
+
+#[test]
+fn every_method_degrades_as_the_sensor_nears_a_moving_boundary() {
+    // The exact ∂E/∂tx grows like ln(1/d): at d = 0 (a sensor on the moving
+    // boundary) it is infinite. The Monte Carlo methods stay unbiased but
+    // their per-path variance grows like 1/d: the edge's ṫ_b = (v·n)/(ω·n)
+    // is ~1/d for the near-grazing directions that still reach it. Finite
+    // differences with the default step are biased once the step exceeds d
+    // (the edge crosses the sensor).
+    let paths = 400_000;
+    let far = sensor_near_moving_edge(0.3);
+    let near = sensor_near_moving_edge(1e-3);
+    let exact_far = Reference::for_scene(&far).unwrap().derivative(0);
+    let exact_near = Reference::for_scene(&near).unwrap().derivative(0);
+    assert!(exact_near > 15.0 * exact_far);
+    for m in [Method::Rendering, Method::Expectation, Method::Transport] {
+        let (ef, vf) = sensitivity(m, &far, paths);
+        let (en, vn) = sensitivity(m, &near, paths);
+        assert!(
+            ef.z_score(exact_far) < 4.0,
+            "{} far: {ef:?} vs {exact_far}",
+            m.name()
+        );
+        assert!(
+            en.z_score(exact_near) < 4.0,
+            "{} near: {en:?} vs {exact_near}",
+            m.name()
+        );
+        assert!(vn > 300.0 * vf, "{} σ²N {vf:.3e} → {vn:.3e}", m.name());
+    }
+    let (fd, _) = sensitivity(Method::Fd, &near, paths);
+    assert!(
+        fd.z_score(exact_near) > 10.0,
+        "finite differences: {fd:?} vs {exact_near}"
+    );
+}
