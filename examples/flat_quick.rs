@@ -1,134 +1,56 @@
-//! Scratch: all flatland methods on a small scene.
-use geosens::flat::*;
-use geosens::{RunConfig, run};
-use glam::DVec2;
+//! Flatland in a few lines: load a scene file, run every method, print each
+//! estimate beside the analytic reference.
+//!
+//! `cargo run --release --example flat_quick -- [SCENE] [PATHS]` (default
+//! `scenes/polygon_occluder.toml`, 10⁶ paths). Scenes without a closed form
+//! (reflectors, scattering media) print the estimates alone.
+use geosens::flat::exact::Reference;
+use geosens::flat::{Method, file};
+use geosens::{Quantity, RunConfig, run};
+use std::path::PathBuf;
 use std::sync::Arc;
 
-fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let which = args.get(1).map(|s| s.as_str()).unwrap_or("occluder");
-    let n: u64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(1_000_000);
-    let emitter = Shape {
-        name: "emitter".into(),
-        vertices: vec![DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0)],
-        closed: false,
-        surface: Surface::Emitter { radiance: 1.0 },
-        medium: None,
-    };
-    let mut shapes = vec![emitter];
-    let occ = match which {
-        "fog" => Shape {
-            name: "occ".into(),
-            vertices: vec![
-                DVec2::new(-0.5, 0.8),
-                DVec2::new(0.7, 0.9),
-                DVec2::new(0.6, 1.3),
-                DVec2::new(-0.4, 1.2),
-            ],
-            closed: true,
-            surface: Surface::Transparent,
-            medium: Some(Medium {
-                ks: 1.2,
-                ke: 1.5,
-                phase: Phase::HenyeyGreenstein { g: 0.3 },
-            }),
-        },
-        "slab" => Shape {
-            name: "occ".into(),
-            vertices: vec![
-                DVec2::new(-0.5, 0.8),
-                DVec2::new(0.7, 0.9),
-                DVec2::new(0.6, 1.3),
-                DVec2::new(-0.4, 1.2),
-            ],
-            closed: true,
-            surface: Surface::Transparent,
-            medium: Some(Medium {
-                ks: 0.0,
-                ke: 1.5,
-                phase: Phase::Isotropic,
-            }),
-        },
-        "reflector" => Shape {
-            name: "occ".into(),
-            vertices: vec![
-                DVec2::new(-0.5, 0.8),
-                DVec2::new(0.7, 0.9),
-                DVec2::new(0.6, 1.3),
-                DVec2::new(-0.4, 1.2),
-            ],
-            closed: true,
-            surface: Surface::Reflector { albedo: 0.8 },
-            medium: None,
-        },
-        _ => Shape {
-            name: "occ".into(),
-            vertices: vec![DVec2::new(-0.6, 1.0), DVec2::new(0.2, 1.0)],
-            closed: false,
-            surface: Surface::Absorber,
-            medium: None,
-        },
-    };
-    shapes.push(occ);
-    if which == "reflector" {
-        shapes[0].vertices = vec![DVec2::new(-1.0, 0.5), DVec2::new(-1.0, 2.0)];
-        shapes[0].vertices.reverse();
-    }
-    let params = vec![
-        Parameter {
-            name: "tx".into(),
-            shape: "occ".into(),
-            motion: Motion::TranslateX,
-        },
-        Parameter {
-            name: "ty".into(),
-            shape: "occ".into(),
-            motion: Motion::TranslateY,
-        },
-        Parameter {
-            name: "rot".into(),
-            shape: "occ".into(),
-            motion: Motion::Rotate { pivot: None },
-        },
-        Parameter {
-            name: "scale".into(),
-            shape: "occ".into(),
-            motion: Motion::Scale { pivot: None },
-        },
-        Parameter {
-            name: "etx".into(),
-            shape: "emitter".into(),
-            motion: Motion::TranslateX,
-        },
-    ];
-    let sensor = Sensor::Irradiance {
-        point: DVec2::ZERO,
-        normal: DVec2::Y,
-    };
-    let scene = Arc::new(Scene::new(shapes, params, sensor).unwrap());
-    if let Some(h) = args.get(3) {
-        let e = methods::FiniteDifference::new(scene.clone(), h.parse().unwrap()).unwrap();
-        let r = run(&e, &RunConfig::new(n, 3).unwrap()).unwrap();
-        print!("fd h={h} {:6.2}s", r.seconds);
-        for (_, est) in &r.estimates {
-            print!(" {:+.5}±{:.5}", est.mean, est.stderr);
-        }
-        println!();
-        return;
-    }
-    for m in [
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let path = args.next().map_or_else(
+        || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/polygon_occluder.toml"),
+        PathBuf::from,
+    );
+    let paths: u64 = args.next().map_or(Ok(1_000_000), |a| a.parse())?;
+    let scene = Arc::new(file::load(&path)?);
+    let reference = Reference::for_scene(&scene).ok();
+    let cfg = RunConfig::new(paths, 1)?;
+    for method in [
         Method::Intensity,
-        Method::Fd,
         Method::Rendering,
         Method::Expectation,
         Method::Transport,
+        Method::Fd,
     ] {
-        let e = m.estimator(scene.clone()).unwrap();
-        let r = run(e.as_ref(), &RunConfig::new(n, 3).unwrap()).unwrap();
-        print!("{:<12} {:6.2}s", m.name(), r.seconds);
-        for (_, est) in &r.estimates {
-            print!(" {:+.5}±{:.5}", est.mean, est.stderr);
+        let r = run(method.estimator(scene.clone())?.as_ref(), &cfg)?;
+        println!("{} ({:.2} s)", method.name(), r.seconds);
+        for (q, e) in &r.estimates {
+            let exact = reference.as_ref().and_then(|reference| match q {
+                Quantity::Intensity => Some(reference.value()),
+                Quantity::Sensitivity(name) => scene
+                    .parameters()
+                    .iter()
+                    .position(|p| &p.name == name)
+                    .map(|j| reference.derivative(j)),
+                Quantity::Gradient(_) => None,
+            });
+            match exact {
+                Some(x) => println!(
+                    "  {:<24} {:+.5} ± {:.5}   exact {:+.5}  (z = {:.1})",
+                    q.to_string(),
+                    e.mean,
+                    e.stderr,
+                    x,
+                    e.z_score(x)
+                ),
+                None => println!("  {:<24} {:+.5} ± {:.5}", q.to_string(), e.mean, e.stderr),
+            }
         }
-        println!();
     }
+    Ok(())
 }

@@ -19,8 +19,11 @@
 //! bit reproducible from a seed whatever the thread count.
 //!
 //! The first scene is the rod of the paper's Section 3 ([`rod`]), with its
-//! exact Bellman–Wing solution ([`rod::exact`]). The book (`book/`) derives
-//! every estimator.
+//! exact Bellman–Wing solution ([`rod::exact`]). The second is flatland
+//! ([`flat`]): polygon scenes in the plane (emitters, absorbers, Lambertian
+//! reflectors, homogeneous media) whose shapes translate, rotate and scale,
+//! with closed-form and quadrature references ([`flat::exact`]) and scene
+//! files ([`flat::file`]). The book (`book/`) derives every estimator.
 //!
 //! ```
 //! use geosens::rod::{Direction, Probe, Rod, Method};

@@ -67,6 +67,26 @@ fn against_reference(name: &str, paths: u64) {
 }
 
 #[test]
+fn transport_gradient_at_the_sensor_matches_the_closed_form() {
+    for name in [
+        "occluder.toml",
+        "polygon_occluder.toml",
+        "absorbing_slab.toml",
+    ] {
+        let scene = scene(name);
+        let (gx, gy) = Reference::for_scene(&scene).unwrap().gradient();
+        let r = estimate(Method::Transport, &scene, 400_000, 8);
+        for (axis, exact) in [("x", gx), ("y", gy)] {
+            let e = r.get(&Quantity::gradient(axis)).unwrap();
+            assert!(
+                e.stderr > 0.0 && e.z_score(exact) < 4.0,
+                "{name} ∂I/∂{axis}: {e:?} vs {exact}"
+            );
+        }
+    }
+}
+
+#[test]
 fn segment_occluder_matches_the_closed_form() {
     against_reference("occluder.toml", 400_000);
 }

@@ -735,6 +735,19 @@ impl Reference {
         }
     }
 
+    /// `(∂E/∂x, ∂E/∂y)`: the gradient with respect to the sensor's position,
+    /// i.e. minus the derivative for the whole scene translating.
+    pub fn gradient(&self) -> (f64, f64) {
+        let along = |axis: DVec2| {
+            let v = move |_: ShapeId, _: DVec2| -axis;
+            match &self.kind {
+                ReferenceKind::Occluded(r) => r.derivative(&v),
+                ReferenceKind::Absorbed(r) => r.derivative(&v),
+            }
+        };
+        (along(DVec2::X), along(DVec2::Y))
+    }
+
     /// `∂E/∂π_j` for the scene's parameter `j`.
     pub fn derivative(&self, j: usize) -> f64 {
         let (id, motion) = self.moves[j];
