@@ -3,8 +3,9 @@
 //! `∂I/∂π_j` for every declared parameter, in declaration order.
 //!
 //! - [`Method::Intensity`]: backward path tracing ([`trace`](super::trace));
-//! - [`Method::Rendering`], [`Method::Expectation`]: the differentiated walk
-//!   ([`walk`](super::walk)) with its two deformations;
+//! - [`Method::Rendering`], [`Method::Expectation`], [`Method::Transport`]:
+//!   the differentiated walk (module `walk`) with its three bookkeepings of
+//!   the path's deformation;
 //! - [`Method::Fd`]: central differences with common random numbers, one
 //!   pair of displaced scenes per parameter.
 use super::geometry::NO_SEGMENT;
@@ -31,8 +32,9 @@ pub enum Method {
     /// it meets moving boundaries, coupled to the radiance gradient there
     /// (nested walks); also returns `∂I/∂x`, `∂I/∂y` at the sensor.
     Transport,
-    /// Central finite differences with common random numbers (step
-    /// [`FD_STEP`] × scene size).
+    /// Central finite differences with common random numbers (half step
+    /// [`FD_STEP`] × scene size for translations, [`FD_STEP`] for rotations
+    /// and scales).
     Fd,
 }
 

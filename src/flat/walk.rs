@@ -1,5 +1,5 @@
-//! The differentiated backward walk shared by the *rendering* and
-//! *expectation* estimators. Every vertex of the path carries, per parameter
+//! The differentiated backward walk shared by the *rendering*,
+//! *expectation* and *transport* estimators. Every vertex of the path carries, per parameter
 //! `j`, a velocity `u_j = ∂x/∂π_j` and its outgoing direction an angular
 //! velocity `φ̇_j`: a choice of how the sampled path deforms when `π_j`
 //! changes. The path weight is differentiated along that deformation (the
@@ -23,7 +23,7 @@
 //!   the visible corners (and of the frame at the horizons), continuous, so
 //!   no boundary term is left; its slope enters the score.
 //!
-//! Book: chapter "Flatland", sections "One deformation, two estimators" and
+//! Book: chapter "Flatland", sections "One deformation, three estimators" and
 //! "The warp field".
 // Slots index several parallel per-parameter arrays at once; index loops
 // read like the formulas.
@@ -363,7 +363,10 @@ impl Walk<'_> {
                 if leibniz && m.ks > 0.0 && hit.is_some() {
                     // Leibniz term at the end of the free-path domain: the
                     // in-scattered radiance just before the boundary.
-                    let end = x + t_b * (1.0 - 1e-9) * w;
+                    // Just before the boundary, but farther than the
+                    // caster's T_MIN even for a nested walk that starts a
+                    // hair in front of a surface.
+                    let end = x + (t_b - (1e-9 * scene.size()).min(0.5 * t_b)) * w;
                     let wi = phase_direction(m.phase, w, rng);
                     let ls = radiance(scene, rng, end, wi, medium, NO_SEGMENT);
                     let term = beta * m.ks * (-m.ke * t_b).exp() * ls;
@@ -571,7 +574,7 @@ impl Walk<'_> {
                 g.u[j] = self.velocity(j, k, y);
             }
         }
-        let start = x + (y - x) * (1.0 - 1e-9);
+        let start = y - (1e-9 * self.scene.size()).min(0.5 * (y - x).length()) * w;
         self.frozen()
             .trace(rng, &mut g, n, start, w, medium, NO_SEGMENT, 1.0);
         for j in 0..n {
