@@ -1,6 +1,7 @@
 //! Flatland: polygon scenes in the plane whose shapes translate, rotate and
 //! scale, with the rod's estimator interface. The book's chapter "Flatland"
 //! derives every estimator.
+pub mod bvh;
 pub mod exact;
 pub mod file;
 pub mod geometry;
