@@ -6,6 +6,7 @@
 use super::geometry::{
     LinearScan, NO_SEGMENT, RayCast, Segment, contains, cross, perp, signed_area,
 };
+use super::corners::CornerGrid;
 use crate::error::Error;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -230,6 +231,11 @@ pub struct Scene {
     /// index to its index there.
     opaque: Box<dyn RayCast>,
     opaque_index: Vec<u32>,
+    /// The opaque segments and their shapes, by opaque index.
+    opaque_segments: Vec<Segment>,
+    opaque_owner: Vec<u32>,
+    /// The corners bucketed for triangle queries (many corners only).
+    corner_grid: Option<CornerGrid>,
     /// Vertices of opaque shapes with their shape: where the integrand over
     /// directions seen from a point can jump.
     corners: Vec<(DVec2, u32)>,
@@ -477,11 +483,13 @@ impl Scene {
         let sensor_medium = medium_at(p, None);
 
         let mut opaque_segments = Vec::new();
+        let mut opaque_owner = Vec::new();
         let mut opaque_index = Vec::with_capacity(segments.len());
         for (i, seg) in segments.iter().enumerate() {
             if shapes[owner[i] as usize].surface.is_opaque() {
                 opaque_index.push(opaque_segments.len() as u32);
                 opaque_segments.push(*seg);
+                opaque_owner.push(owner[i]);
             } else {
                 opaque_index.push(NO_SEGMENT);
             }
@@ -491,11 +499,17 @@ impl Scene {
             .enumerate()
             .filter(|(_, s)| s.surface.is_opaque())
             .flat_map(|(k, s)| s.vertices.iter().map(move |&v| (v, k as u32)))
-            .collect();
+            .collect::<Vec<(DVec2, u32)>>();
+        let corner_grid = (corners.len() > GRID_THRESHOLD).then(|| {
+            CornerGrid::new(&corners.iter().map(|c| c.0).collect::<Vec<_>>())
+        });
         Ok(Scene {
             caster: caster(segments.clone()),
-            opaque: caster(opaque_segments),
+            opaque: caster(opaque_segments.clone()),
             opaque_index,
+            opaque_segments,
+            opaque_owner,
+            corner_grid,
             corners,
             shapes,
             parameters: resolved,
@@ -585,6 +599,27 @@ impl Scene {
         };
         !self.opaque.any_hit(from, d / len, len * (1.0 - 1e-9), skip)
     }
+    /// The first opaque segment along a ray (not `skip`): distance, the
+    /// segment and its shape.
+    #[inline]
+    pub fn opaque_hit(&self, origin: DVec2, dir: DVec2, skip: u32) -> Option<(f64, Segment, u32)> {
+        let skip = if skip == NO_SEGMENT {
+            NO_SEGMENT
+        } else {
+            self.opaque_index[skip as usize]
+        };
+        self.opaque
+            .closest_hit(origin, dir, f64::INFINITY, skip)
+            .map(|h| {
+                let i = h.segment as usize;
+                (h.t, self.opaque_segments[i], self.opaque_owner[i])
+            })
+    }
+    /// The corners bucketed for triangle queries, for scenes with more than
+    /// [`GRID_THRESHOLD`] corners.
+    pub fn corner_grid(&self) -> Option<&CornerGrid> {
+        self.corner_grid.as_ref()
+    }
     /// Vertices of opaque shapes, with their shape.
     pub fn corners(&self) -> &[(DVec2, u32)] {
         &self.corners
@@ -616,6 +651,9 @@ fn caster(segments: Vec<Segment>) -> Box<dyn RayCast> {
         Box::new(super::bvh::SegmentBvh::new(segments))
     }
 }
+
+/// Most corners the warp scans one by one; above, a [`CornerGrid`].
+pub const GRID_THRESHOLD: usize = 64;
 
 /// Most segments a scene traces by linear scan; above, a BVH.
 pub const BVH_THRESHOLD: usize = 24;

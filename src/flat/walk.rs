@@ -798,6 +798,9 @@ impl Walk<'_> {
             }
         };
         let (lim_ccw, lim_cw) = (limit(h_ccw), limit(h_cw));
+        if let Some(knots) = self.knots_in_triangles(x, skip, w, lim_ccw, lim_cw) {
+            return knots;
+        }
         let (mut bound_ccw, mut bound_cw) = (0.0, 0.0);
         let (mut done_ccw, mut done_cw) = (false, false);
         let (mut ccw, mut cw) = (None, None);
@@ -850,6 +853,66 @@ impl Walk<'_> {
             })
         };
         (knot(ccw, 1.0), knot(cw, -1.0))
+    }
+
+    /// [`Self::nearest_knots`] through the corner grid: the nearest visible
+    /// corner on each side is the hit segment's end there or the
+    /// smallest-angle corner inside the triangle (vertex, hit point, end);
+    /// the module `corners` proves it. `None` (use the scan) without a grid
+    /// or when the direction hits nothing opaque.
+    fn knots_in_triangles(
+        &self,
+        x: DVec2,
+        skip: u32,
+        w: DVec2,
+        lim_ccw: f64,
+        lim_cw: f64,
+    ) -> Option<(Option<Knot>, Option<Knot>)> {
+        let scene = self.scene;
+        let grid = scene.corner_grid()?;
+        let (t, seg, k_hit) = scene.opaque_hit(x, w, skip)?;
+        let p = x + t * w;
+        let (sa, sb) = (cross(w, seg.a - x), cross(w, seg.b - x));
+        let (e_ccw, e_cw) = if sa > 0.0 && sb < 0.0 {
+            (seg.a, seg.b)
+        } else if sb > 0.0 && sa < 0.0 {
+            (seg.b, seg.a)
+        } else {
+            return None; // the ray grazes an end: let the scan decide
+        };
+        let corners = scene.corners();
+        let side = |e: DVec2, lim: f64, ccw: bool| -> Option<Knot> {
+            let angle = |q: DVec2| {
+                let r = q - x;
+                let pa = pseudo_angle(w.dot(r), cross(w, r));
+                if ccw { pa } else { 4.0 - pa }
+            };
+            let mut best: Option<(f64, DVec2, u32)> = None;
+            let pe = angle(e);
+            if pe < lim {
+                best = Some((pe, e, k_hit));
+            }
+            grid.near_triangle(x, p, e, |i| {
+                let (q, k) = corners[i as usize];
+                let pq = angle(q);
+                if pq < lim
+                    && best.is_none_or(|b| pq < b.0)
+                    && super::corners::inside(x, p, e, q)
+                {
+                    best = Some((pq, q, k));
+                }
+            });
+            best.map(|(_, q, k)| {
+                let r = q - x;
+                let sign = if ccw { 1.0 } else { -1.0 };
+                let mut a = sign * cross(w, r).atan2(w.dot(r));
+                if a <= 0.0 {
+                    a += std::f64::consts::TAU;
+                }
+                (a, q, k)
+            })
+        };
+        Some((side(e_ccw, lim_ccw, true), side(e_cw, lim_cw, false)))
     }
 
     /// The neighbours of `w` among the sensor's knots (precomputed: the
