@@ -2,6 +2,7 @@
 //! scale, with the rod's estimator interface. The book's chapter "Flatland"
 //! derives every estimator.
 pub mod exact;
+pub mod figures;
 pub mod file;
 pub mod geometry;
 pub mod methods;
