@@ -1,7 +1,8 @@
 //! Figures as plain data, drawn by plotters to PNG and SVG.
 //!
 //! A [`Figure`] is a grid of [`Panel`]s; a panel holds [`Series`] (lines,
-//! points with ±σ error bars) or one heat map. The experiments build figures
+//! points with ±σ error bars, markers, filled polygons in data coordinates)
+//! and optionally one heat map. The experiments build figures
 //! from their results and [`Figure::save`] writes `name.png` and `name.svg`.
 //! Log axes are drawn by plotting `log10` of the data on linear axes with
 //! `10^k` tick labels, so one code path serves every panel.
@@ -19,6 +20,19 @@ pub enum Mark {
     Dashed(Vec<(f64, f64)>),
     /// Points `(x, mean, σ)` with ±σ error bars.
     Points(Vec<(f64, f64, f64)>),
+    /// A thin (1 px) polyline through `(x, y)`: many light lines, such as
+    /// sampled paths.
+    Thin(Vec<(f64, f64)>),
+    /// Hollow circles at `(x, y)`.
+    Circles(Vec<(f64, f64)>),
+    /// A closed polygon through `vertices` (in data coordinates), outlined
+    /// and filled with the series colour at `opacity` (in `[0, 1]`).
+    Polygon {
+        /// The vertices, in order; the last connects back to the first.
+        vertices: Vec<(f64, f64)>,
+        /// Opacity of the fill (the outline is opaque).
+        opacity: f64,
+    },
 }
 
 /// One labelled series of a panel.
@@ -57,6 +71,33 @@ impl Series {
             label: label.into(),
             color,
             mark: Mark::Points(xys),
+        }
+    }
+
+    /// A thin (1 px) polyline.
+    pub fn thin(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Thin(xy),
+        }
+    }
+
+    /// Hollow circles.
+    pub fn circles(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Circles(xy),
+        }
+    }
+
+    /// A filled polygon in data coordinates (a bar, a shape of a scene).
+    pub fn polygon(label: &str, color: usize, vertices: Vec<(f64, f64)>, opacity: f64) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Polygon { vertices, opacity },
         }
     }
 }
@@ -98,6 +139,18 @@ pub struct Panel {
     pub x_tick_names: Vec<String>,
     /// Names for the integer y ticks, as `x_tick_names`.
     pub y_tick_names: Vec<String>,
+    /// Fixed x range in data units (instead of the data's, padded).
+    pub x_range: Option<(f64, f64)>,
+    /// Fixed y range in data units (instead of the data's, padded).
+    pub y_range: Option<(f64, f64)>,
+    /// Draw no axes, only the legend of the series (at the upper left, in
+    /// a larger font): a figure's shared legend in a panel of its own. The
+    /// series should hold no data.
+    pub legend_only: bool,
+    /// One unit takes as many pixels along x as along y (drawings of
+    /// scenes): the shorter data range is widened about its centre to the
+    /// chart's aspect. Linear axes only.
+    pub equal_aspect: bool,
 }
 
 /// Legend placement inside a panel.
@@ -152,7 +205,11 @@ fn bounds(p: &Panel) -> ((f64, f64), (f64, f64)) {
     let (mut xs, mut ys) = (Vec::new(), Vec::new());
     for s in &p.series {
         match &s.mark {
-            Mark::Line(v) | Mark::Dashed(v) => v.iter().for_each(|&(x, y)| {
+            Mark::Line(v)
+            | Mark::Dashed(v)
+            | Mark::Thin(v)
+            | Mark::Circles(v)
+            | Mark::Polygon { vertices: v, .. } => v.iter().for_each(|&(x, y)| {
                 xs.push(axis(x, p.x_log));
                 ys.push(axis(y, p.y_log));
             }),
@@ -179,7 +236,15 @@ fn bounds(p: &Panel) -> ((f64, f64), (f64, f64)) {
         (lo - pad * w, hi + pad * w)
     };
     let pad = if p.heat.is_some() { 0.0 } else { 0.04 };
-    (span(xs, pad), span(ys, pad))
+    let fixed = |range: Option<(f64, f64)>, log: bool| {
+        let (lo, hi) = range?;
+        let (lo, hi) = (axis(lo, log)?, axis(hi, log)?);
+        (hi > lo).then_some((lo, hi))
+    };
+    (
+        fixed(p.x_range, p.x_log).unwrap_or_else(|| span(xs, pad)),
+        fixed(p.y_range, p.y_log).unwrap_or_else(|| span(ys, pad)),
+    )
 }
 
 /// A colour on a blue–white–red scale for `t ∈ [0, 1]`.
@@ -203,28 +268,93 @@ pub fn diverging(t: f64) -> RGBColor {
     }
 }
 
+/// Margin around every chart, in pixels.
+const MARGIN: u32 = 12;
+/// Height of the x axis' label area, in pixels.
+const X_LABEL_AREA: u32 = 40;
+/// Width of the y axis' label area, in pixels.
+const Y_LABEL_AREA: u32 = 70;
+/// Font size of panel titles.
+const TITLE_SIZE: u32 = 18;
+
+/// `x` and `y` ranges widened so that one unit spans as many pixels along
+/// both axes of the chart `p` gets in `area` (plotters lays a chart out as
+/// margin, then title, then label areas; this repeats that arithmetic).
+fn equal_aspect<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &Panel,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> ((f64, f64), (f64, f64)) {
+    let (w, h) = area.dim_in_pixel();
+    let style = ("sans-serif", TITLE_SIZE).into_text_style(area);
+    let title_h = area
+        .estimate_text_size(&p.title, &style)
+        .map_or(TITLE_SIZE, |(_, th)| th);
+    let title = title_h + 2 * (title_h / 2).min(5);
+    let pw = f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1));
+    let ph = f64::from(h.saturating_sub(2 * MARGIN + title + X_LABEL_AREA).max(1));
+    let unit = ((x1 - x0) / pw).max((y1 - y0) / ph);
+    let widen = |lo: f64, hi: f64, px: f64| {
+        let (c, half) = (0.5 * (lo + hi), 0.5 * unit * px);
+        (c - half, c + half)
+    };
+    (widen(x0, x1, pw), widen(y0, y1, ph))
+}
+
+/// What a legend entry shows for a series.
+#[derive(Debug, Clone, Copy)]
+enum Glyph {
+    /// A short line of this width.
+    Line(u32),
+    /// A filled box of this opacity.
+    Fill(f64),
+    /// A hollow circle.
+    Ring,
+    /// A dot.
+    Dot,
+}
+
+impl Glyph {
+    fn of(mark: &Mark) -> Glyph {
+        match mark {
+            Mark::Polygon { opacity, .. } => Glyph::Fill(opacity.max(0.3)),
+            Mark::Circles(_) => Glyph::Ring,
+            Mark::Points(_) => Glyph::Dot,
+            Mark::Thin(_) => Glyph::Line(1),
+            _ => Glyph::Line(2),
+        }
+    }
+}
+
 fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), Error> {
-    let ((x0, x1), (y0, y1)) = bounds(p);
+    let ((mut x0, mut x1), (mut y0, mut y1)) = bounds(p);
+    if p.equal_aspect && !p.x_log && !p.y_log {
+        ((x0, x1), (y0, y1)) = equal_aspect(area, p, (x0, x1), (y0, y1));
+    }
+    let axes = if p.legend_only { 0 } else { 1 };
     let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, ("sans-serif", 18))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
+        .caption(&p.title, ("sans-serif", TITLE_SIZE))
+        .margin(MARGIN)
+        .x_label_area_size(X_LABEL_AREA * axes)
+        .y_label_area_size(Y_LABEL_AREA * axes)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(plot_err)?;
     let fmt_x = |v: &f64| named_tick(*v, p.x_log, &p.x_tick_names);
     let fmt_y = |v: &f64| named_tick(*v, p.y_log, &p.y_tick_names);
-    chart
-        .configure_mesh()
-        .x_desc(p.x_label.as_str())
-        .y_desc(p.y_label.as_str())
-        .x_label_formatter(&fmt_x)
-        .y_label_formatter(&fmt_y)
-        .x_labels(label_count(&p.x_tick_names))
-        .y_labels(label_count(&p.y_tick_names))
-        .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(plot_err)?;
+    if !p.legend_only {
+        chart
+            .configure_mesh()
+            .x_desc(p.x_label.as_str())
+            .y_desc(p.y_label.as_str())
+            .x_label_formatter(&fmt_x)
+            .y_label_formatter(&fmt_y)
+            .x_labels(label_count(&p.x_tick_names))
+            .y_labels(label_count(&p.y_tick_names))
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(plot_err)?;
+    }
     if let Some(h) = &p.heat {
         let nx = h.x_edges.len() - 1;
         let cells = h.values.iter().enumerate().map(|(i, &v)| {
@@ -248,39 +378,86 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
     for s in &p.series {
         let color = PALETTE[s.color % PALETTE.len()];
         let to_axis = |&(x, y): &(f64, f64)| Some((axis(x, p.x_log)?, axis(y, p.y_log)?));
-        let anno = match &s.mark {
-            Mark::Line(v) => chart
-                .draw_series(LineSeries::new(
-                    v.iter().filter_map(to_axis),
-                    color.stroke_width(2),
-                ))
-                .map_err(plot_err)?,
-            Mark::Dashed(v) => chart
-                .draw_series(DashedLineSeries::new(
-                    v.iter().filter_map(to_axis),
-                    6,
-                    4,
-                    color.stroke_width(1),
-                ))
-                .map_err(plot_err)?,
-            Mark::Points(v) => chart
-                .draw_series(v.iter().filter_map(|&(x, m, e)| {
-                    let x = axis(x, p.x_log)?;
-                    let mid = axis(m, p.y_log)?;
-                    let lo = axis(m - e, p.y_log).unwrap_or(y0);
-                    let hi = axis(m + e, p.y_log)?;
-                    Some(ErrorBar::new_vertical(x, lo, mid, hi, color.filled(), 6))
-                }))
-                .map_err(plot_err)?,
-        };
+        let anno =
+            match &s.mark {
+                Mark::Line(v) => chart
+                    .draw_series(LineSeries::new(
+                        v.iter().filter_map(to_axis),
+                        color.stroke_width(2),
+                    ))
+                    .map_err(plot_err)?,
+                Mark::Dashed(v) => chart
+                    .draw_series(DashedLineSeries::new(
+                        v.iter().filter_map(to_axis),
+                        6,
+                        4,
+                        color.stroke_width(1),
+                    ))
+                    .map_err(plot_err)?,
+                Mark::Points(v) => chart
+                    .draw_series(v.iter().filter_map(|&(x, m, e)| {
+                        let x = axis(x, p.x_log)?;
+                        let mid = axis(m, p.y_log)?;
+                        let lo = axis(m - e, p.y_log).unwrap_or(y0);
+                        let hi = axis(m + e, p.y_log)?;
+                        Some(ErrorBar::new_vertical(x, lo, mid, hi, color.filled(), 6))
+                    }))
+                    .map_err(plot_err)?,
+                Mark::Thin(v) => chart
+                    .draw_series(LineSeries::new(
+                        v.iter().filter_map(to_axis),
+                        color.stroke_width(1),
+                    ))
+                    .map_err(plot_err)?,
+                Mark::Circles(v) => chart
+                    .draw_series(
+                        v.iter()
+                            .filter_map(to_axis)
+                            .map(|c| Circle::new(c, 6, color.stroke_width(2))),
+                    )
+                    .map_err(plot_err)?,
+                Mark::Polygon { vertices, opacity } => {
+                    let v: Vec<(f64, f64)> = vertices.iter().filter_map(to_axis).collect();
+                    chart
+                        .draw_series(std::iter::once(Polygon::new(
+                            v.clone(),
+                            color.mix(opacity.clamp(0.0, 1.0)).filled(),
+                        )))
+                        .map_err(plot_err)?;
+                    let outline = v.first().map(|&first| v.iter().copied().chain([first]));
+                    chart
+                        .draw_series(outline.map(|o| {
+                            PathElement::new(o.collect::<Vec<_>>(), color.stroke_width(1))
+                        }))
+                        .map_err(plot_err)?
+                }
+            };
         if !s.label.is_empty() {
             legend = true;
-            anno.label(s.label.as_str()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
+            let anno = anno.label(s.label.as_str());
+            match Glyph::of(&s.mark) {
+                Glyph::Line(w) => anno.legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(w))
+                }),
+                Glyph::Fill(a) => anno.legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 18, y + 5)], color.mix(a).filled())
+                }),
+                Glyph::Ring => {
+                    anno.legend(move |(x, y)| Circle::new((x + 9, y), 5, color.stroke_width(2)))
+                }
+                Glyph::Dot => anno.legend(move |(x, y)| Circle::new((x + 9, y), 4, color.filled())),
+            };
         }
     }
-    if legend {
+    if legend && p.legend_only {
+        chart
+            .configure_series_labels()
+            .label_font(("sans-serif", TITLE_SIZE))
+            .border_style(WHITE)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(plot_err)?;
+    } else if legend {
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))
@@ -295,6 +472,101 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
             .map_err(plot_err)?;
     }
     Ok(())
+}
+
+/// Legend-sized box of [`single_legend`]: 45% of a chart's width, 40% of
+/// its height.
+pub const LEGEND_BOX: (f64, f64) = (0.45, 0.4);
+
+/// The corner of `panel`'s chart, out of `prefer` (in order of preference),
+/// whose legend-sized box (`size`: fractions of the data ranges' width and
+/// height, e.g. [`LEGEND_BOX`]) covers the fewest drawn points (lines and
+/// polygon outlines sampled along their segments), with that count.
+pub fn quiet_corner(panel: &Panel, prefer: &[Legend], size: (f64, f64)) -> (Legend, usize) {
+    let to_axis = |v: f64, log: bool| if log { v.log10() } else { v };
+    let mut pts = Vec::new();
+    let mut push = |x: f64, y: f64| {
+        let (x, y) = (to_axis(x, panel.x_log), to_axis(y, panel.y_log));
+        if x.is_finite() && y.is_finite() {
+            pts.push((x, y));
+        }
+    };
+    for s in &panel.series {
+        let (v, closed) = match &s.mark {
+            Mark::Points(v) => {
+                v.iter().for_each(|&(x, y, _)| push(x, y));
+                continue;
+            }
+            Mark::Circles(v) => {
+                v.iter().for_each(|&(x, y)| push(x, y));
+                continue;
+            }
+            Mark::Line(v) | Mark::Dashed(v) | Mark::Thin(v) => (v, false),
+            Mark::Polygon { vertices, .. } => (vertices, true),
+        };
+        let close = if closed { v.first().copied() } else { None };
+        let line: Vec<(f64, f64)> = v.iter().copied().chain(close).collect();
+        for w in line.windows(2) {
+            for k in 0..8 {
+                let t = f64::from(k) / 8.0;
+                push(
+                    w[0].0 + t * (w[1].0 - w[0].0),
+                    w[0].1 + t * (w[1].1 - w[0].1),
+                );
+            }
+        }
+        if let Some(&(x, y)) = line.last() {
+            push(x, y);
+        }
+    }
+    let span = |f: fn(&(f64, f64)) -> f64| {
+        pts.iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    let ((x0, x1), (y0, y1)) = (span(|p| p.0), span(|p| p.1));
+    let covered = |corner: Legend| {
+        let (left, low) = match corner {
+            Legend::UpperLeft => (true, false),
+            Legend::UpperRight => (false, false),
+            Legend::LowerLeft => (true, true),
+            Legend::LowerRight => (false, true),
+        };
+        let (w, h) = (size.0 * (x1 - x0), size.1 * (y1 - y0));
+        pts.iter()
+            .filter(|&&(x, y)| {
+                (if left { x <= x0 + w } else { x >= x1 - w })
+                    && (if low { y <= y0 + h } else { y >= y1 - h })
+            })
+            .count()
+    };
+    prefer
+        .iter()
+        .map(|&c| (c, covered(c)))
+        .min_by_key(|&(_, n)| n)
+        .unwrap_or_default()
+}
+
+/// One legend for panels that share their series styles: the panel and
+/// corner (out of `prefer`) where a [`LEGEND_BOX`] covers the fewest points
+/// keeps its labels; the other panels lose theirs.
+pub fn single_legend(panels: &mut [Panel], prefer: &[Legend]) {
+    let best = panels
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (i, quiet_corner(p, prefer, LEGEND_BOX)))
+        .min_by_key(|&(_, (_, n))| n);
+    if let Some((keep, (corner, _))) = best {
+        for (i, p) in panels.iter_mut().enumerate() {
+            if i == keep {
+                p.legend = corner;
+            } else {
+                p.series.iter_mut().for_each(|s| s.label.clear());
+            }
+        }
+    }
 }
 
 /// Tick label on an axis with `names` for its integer ticks (categorical),
@@ -401,5 +673,67 @@ impl Figure {
         self.draw(BitMapBackend::new(&png, self.size()).into_drawing_area())?;
         self.draw(SVGBackend::new(&svg, self.size()).into_drawing_area())?;
         Ok(vec![png, svg])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn panel(series: Vec<Series>) -> Panel {
+        Panel {
+            title: "t".into(),
+            series,
+            ..Panel::default()
+        }
+    }
+
+    #[test]
+    fn fixed_ranges_override_the_data() {
+        let mut p = panel(vec![Series::line("", 0, vec![(0.0, 0.0), (1.0, 1.0)])]);
+        p.x_range = Some((-2.0, 3.0));
+        let ((x0, x1), (y0, y1)) = bounds(&p);
+        assert_eq!((x0, x1), (-2.0, 3.0));
+        assert!(y0 < 0.0 && y1 > 1.0);
+    }
+
+    #[test]
+    fn polygons_count_for_the_quiet_corner() {
+        // A filled box in the upper right: the legend goes elsewhere.
+        let p = panel(vec![
+            Series::polygon(
+                "box",
+                0,
+                vec![(0.6, 0.6), (1.0, 0.6), (1.0, 1.0), (0.6, 1.0)],
+                0.5,
+            ),
+            Series::circles("", 1, vec![(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]),
+        ]);
+        let (corner, _) = quiet_corner(&p, &[Legend::UpperRight, Legend::LowerLeft], LEGEND_BOX);
+        assert_eq!(corner, Legend::LowerLeft);
+    }
+
+    #[test]
+    fn every_mark_draws() {
+        let dir = std::env::temp_dir().join(format!("geosens-plot-{}", std::process::id()));
+        let mut scene = panel(vec![
+            Series::polygon("shape", 0, vec![(0.0, 0.0), (2.0, 0.0), (1.0, 1.0)], 0.3),
+            Series::thin("path", 1, vec![(0.0, 0.0), (1.0, 2.0)]),
+            Series::circles("corner", 2, vec![(2.0, 0.0)]),
+            Series::points("dot", 3, vec![(1.0, 1.0, 0.0)]),
+        ]);
+        scene.equal_aspect = true;
+        let legend = Panel {
+            series: vec![Series::polygon("only a legend", 4, vec![], 1.0)],
+            legend_only: true,
+            ..Panel::default()
+        };
+        let written = Figure::new(vec![scene, legend], 2)
+            .save(&dir, "marks")
+            .unwrap();
+        for path in &written {
+            assert!(std::fs::metadata(path).unwrap().len() > 1000);
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

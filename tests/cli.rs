@@ -335,6 +335,11 @@ fn compare_writes_the_figures() {
         "efficiency",
         "stability",
         "finite_difference",
+        "flat_scene",
+        "flat_warp",
+        "flat_against_pi",
+        "flat_convergence",
+        "flat_efficiency",
     ] {
         // Every figure writes its picture twice and the numbers behind it.
         for (ext, least) in [("png", 1000), ("svg", 1000), ("json", 1)] {

@@ -5,7 +5,8 @@
 //!   probe on a rod with one method, or evaluates the exact solution
 //!   (`--method exact`), and prints a table or one JSON line;
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
-//!   and thick rods at a few probes and prints them beside the exact solution.
+//!   and thick rods at a few probes and prints them beside the exact solution,
+//!   then writes the rod's figures and flatland's (`flat_*`).
 //!
 //! Bad input exits with status 1 and `error: …` naming the value (clap's own
 //! parse errors exit with status 2).
@@ -37,7 +38,7 @@ enum Command {
     /// Estimate I, ∂I/∂length (and ∂I/∂x) at one probe on a rod.
     Rod(RodArgs),
     /// Compare the four methods with the exact solution on the paper's rods,
-    /// then write the rod's figures.
+    /// then write the rod's figures and flatland's.
     Compare(CompareArgs),
     /// Estimate I and ∂I/∂π for every parameter of a flatland scene file.
     Flat(FlatArgs),
@@ -458,7 +459,8 @@ fn compare_command(
         opts.effort = effort;
         opts.progress = io::stderr().is_terminal();
         let start = Instant::now();
-        let written = figures::all(&opts)?;
+        let mut written = figures::all(&opts)?;
+        written.extend(geosens::flat::figures::all(&opts)?);
         writeln!(
             out,
             "\nwrote {} files to {} in {:.1} s",

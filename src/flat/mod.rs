@@ -4,6 +4,7 @@
 pub mod bvh;
 pub mod corners;
 pub mod exact;
+pub mod figures;
 pub mod file;
 pub mod geometry;
 pub mod methods;

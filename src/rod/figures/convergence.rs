@@ -12,7 +12,7 @@
 use super::{FigureOptions, exact_value, thick, thin};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::plot::{Figure, Legend, Mark, Panel, Series};
+use crate::plot::{Figure, Legend, Panel, Series, single_legend};
 use crate::rod::{Direction, Method, PARAMETER, Rod};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -92,87 +92,6 @@ pub(super) fn omega_label(omega: Direction) -> &'static str {
     match omega {
         Direction::Right => "ω = +1",
         Direction::Left => "ω = −1",
-    }
-}
-
-/// The corner of `panel`'s chart, out of `prefer` (in order of preference),
-/// whose legend-sized box (45% of the width, 40% of the height) covers the
-/// fewest drawn points (lines sampled along their segments), with that count.
-fn quiet_corner(panel: &Panel, prefer: &[Legend]) -> (Legend, usize) {
-    let to_axis = |v: f64, log: bool| if log { v.log10() } else { v };
-    let mut pts = Vec::new();
-    let mut push = |x: f64, y: f64| {
-        let (x, y) = (to_axis(x, panel.x_log), to_axis(y, panel.y_log));
-        if x.is_finite() && y.is_finite() {
-            pts.push((x, y));
-        }
-    };
-    for s in &panel.series {
-        match &s.mark {
-            Mark::Line(v) | Mark::Dashed(v) => {
-                for w in v.windows(2) {
-                    for k in 0..8 {
-                        let t = f64::from(k) / 8.0;
-                        push(
-                            w[0].0 + t * (w[1].0 - w[0].0),
-                            w[0].1 + t * (w[1].1 - w[0].1),
-                        );
-                    }
-                }
-                if let Some(&(x, y)) = v.last() {
-                    push(x, y);
-                }
-            }
-            Mark::Points(v) => v.iter().for_each(|&(x, y, _)| push(x, y)),
-        }
-    }
-    let span = |f: fn(&(f64, f64)) -> f64| {
-        pts.iter()
-            .map(f)
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                (lo.min(v), hi.max(v))
-            })
-    };
-    let ((x0, x1), (y0, y1)) = (span(|p| p.0), span(|p| p.1));
-    let covered = |corner: Legend| {
-        let (left, low) = match corner {
-            Legend::UpperLeft => (true, false),
-            Legend::UpperRight => (false, false),
-            Legend::LowerLeft => (true, true),
-            Legend::LowerRight => (false, true),
-        };
-        let (w, h) = (0.45 * (x1 - x0), 0.4 * (y1 - y0));
-        pts.iter()
-            .filter(|&&(x, y)| {
-                (if left { x <= x0 + w } else { x >= x1 - w })
-                    && (if low { y <= y0 + h } else { y >= y1 - h })
-            })
-            .count()
-    };
-    prefer
-        .iter()
-        .map(|&c| (c, covered(c)))
-        .min_by_key(|&(_, n)| n)
-        .unwrap_or_default()
-}
-
-/// One legend for panels that share their series styles: the panel and
-/// corner (out of `prefer`) where it covers the fewest points keeps its
-/// labels; the other panels lose theirs.
-pub(super) fn single_legend(panels: &mut [Panel], prefer: &[Legend]) {
-    let best = panels
-        .iter()
-        .enumerate()
-        .map(|(i, p)| (i, quiet_corner(p, prefer)))
-        .min_by_key(|&(_, (_, n))| n);
-    if let Some((keep, (corner, _))) = best {
-        for (i, p) in panels.iter_mut().enumerate() {
-            if i == keep {
-                p.legend = corner;
-            } else {
-                p.series.iter_mut().for_each(|s| s.label.clear());
-            }
-        }
     }
 }
 

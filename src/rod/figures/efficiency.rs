@@ -12,12 +12,11 @@
 //! Points with `σ = 0` (a probe where every path scores the same, e.g. at
 //! `x = 0`, `ω = +1`) cannot be drawn on the log axis and are left out.
 use super::convergence::{
-    Case, FALLING, NEAR_END, Record, error_panel, omega_label, path_counts, rod_title, rods,
-    single_legend, style,
+    Case, FALLING, NEAR_END, Record, error_panel, omega_label, path_counts, rod_title, rods, style,
 };
 use super::{FigureOptions, positions};
 use crate::error::Error;
-use crate::plot::{Figure, Legend, Panel, Series};
+use crate::plot::{Figure, Legend, Panel, Series, single_legend};
 use crate::rod::{Direction, Method};
 use serde::Serialize;
 use std::path::PathBuf;

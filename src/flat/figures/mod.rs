@@ -1,0 +1,145 @@
+//! Flatland's figures (the book's chapter "Flatland"): each is one function
+//! that runs its experiment, deterministic from the seed, draws it with
+//! [`crate::plot`] and writes `flat_<name>.{png,svg}` and the numbers behind
+//! it, `flat_<name>.json`, under the output folder. They take the rod's
+//! [`FigureOptions`]; the examples `examples/fig_flat_*.rs` each call one and
+//! `geosens compare --figures DIR` calls them all after the rod's.
+//!
+//! The scenes are the files of `scenes/`, compiled in ([`scene_file`]), so
+//! the figures do not depend on the working directory.
+use super::exact::Reference;
+use super::{Method, Scene, file};
+use crate::error::Error;
+use crate::runner::{RunConfig, RunResult, run};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+pub use crate::rod::figures::{FigureFn, FigureOptions};
+
+pub mod against_pi;
+pub mod convergence;
+pub mod efficiency;
+pub mod scene;
+pub mod warp;
+
+/// The Monte Carlo methods in the figures' order.
+pub const METHODS: [Method; 5] = [
+    Method::Intensity,
+    Method::Expectation,
+    Method::Rendering,
+    Method::Transport,
+    Method::Fd,
+];
+
+/// The methods that estimate `∂E/∂π`.
+pub const DERIVATIVE_METHODS: [Method; 4] = [
+    Method::Expectation,
+    Method::Rendering,
+    Method::Transport,
+    Method::Fd,
+];
+
+/// Palette index of `method` in every flatland figure.
+pub fn color(method: Method) -> usize {
+    match method {
+        Method::Intensity => 0,
+        Method::Expectation => 1,
+        Method::Rendering => 2,
+        Method::Transport => 3,
+        Method::Fd => 4,
+    }
+}
+
+/// Palette index of analytic curves and reference lines (black).
+pub const REFERENCE_COLOR: usize = 6;
+
+/// Every flatland figure, in the book's order; returns the files written.
+pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
+    let figures: [FigureFn; 5] = [
+        scene::scene,
+        warp::warp,
+        against_pi::against_pi,
+        convergence::convergence,
+        efficiency::efficiency,
+    ];
+    let mut written = Vec::new();
+    for figure in figures {
+        written.extend(figure(opts)?);
+    }
+    Ok(written)
+}
+
+/// The text of `scenes/<name>.toml`, compiled in; `None` for a name that is
+/// not one of the shipped scenes.
+pub fn scene_file(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "occluder" => include_str!("../../../scenes/occluder.toml"),
+        "polygon_occluder" => include_str!("../../../scenes/polygon_occluder.toml"),
+        "absorbing_slab" => include_str!("../../../scenes/absorbing_slab.toml"),
+        "fog" => include_str!("../../../scenes/fog.toml"),
+        "reflector" => include_str!("../../../scenes/reflector.toml"),
+        "three_shapes" => include_str!("../../../scenes/three_shapes.toml"),
+        "radiance" => include_str!("../../../scenes/radiance.toml"),
+        _ => return None,
+    })
+}
+
+/// The shipped scene `scenes/<name>.toml`.
+pub fn load(name: &str) -> Result<Scene, Error> {
+    let text =
+        scene_file(name).ok_or_else(|| Error::Scene(format!("no shipped scene {name:?}")))?;
+    file::from_toml(text).map_err(|e| Error::Scene(format!("scenes/{name}.toml: {e}")))
+}
+
+/// Index of the parameter called `name` in `scene`.
+pub fn parameter(scene: &Scene, name: &str) -> Result<usize, Error> {
+    scene
+        .parameters()
+        .iter()
+        .position(|p| p.name == name)
+        .ok_or_else(|| Error::Scene(format!("the scene has no parameter {name:?}")))
+}
+
+/// `scene` with parameter `j` only (pivots stay resolved), so that a run
+/// pays for that one sensitivity; its index becomes 0.
+pub fn only(scene: &Scene, j: usize) -> Result<Scene, Error> {
+    let p = scene
+        .parameters()
+        .get(j)
+        .ok_or_else(|| Error::Scene(format!("no parameter {j}")))?;
+    Scene::new(scene.shapes().to_vec(), vec![p.clone()], scene.sensor())
+}
+
+/// The analytic `E` and `∂E/∂π_j` of `scene`.
+pub fn exact(scene: &Scene, j: usize) -> Result<(f64, f64), Error> {
+    let r = Reference::for_scene(scene)?;
+    Ok((r.value(), r.derivative(j)))
+}
+
+/// Runs `method` on `scene` with `paths` (scaled by the effort) paths, seed
+/// `opts.seed + salt`, on `threads` threads.
+pub fn run_method(
+    opts: &FigureOptions,
+    method: Method,
+    scene: &Arc<Scene>,
+    paths: u64,
+    salt: u64,
+    threads: usize,
+) -> Result<RunResult, Error> {
+    let cfg = RunConfig::new(opts.paths(paths), opts.seed.wrapping_add(salt))?.threads(threads);
+    run(method.estimator(Arc::clone(scene))?.as_ref(), &cfg)
+}
+
+/// The file names (`flat_<name>.{png,svg}`) of a figure, saved with its
+/// JSON: what every figure function returns.
+pub(crate) fn save<T: serde::Serialize>(
+    opts: &FigureOptions,
+    name: &str,
+    figure: &crate::plot::Figure,
+    numbers: &T,
+) -> Result<Vec<PathBuf>, Error> {
+    let name = format!("flat_{name}");
+    let mut written = figure.save(&opts.out, &name)?;
+    written.push(opts.write_json(&name, numbers)?);
+    Ok(written)
+}
