@@ -340,6 +340,7 @@ fn compare_writes_the_figures() {
         "flat_against_pi",
         "flat_convergence",
         "flat_efficiency",
+        "flat_stability",
     ] {
         // Every figure writes its picture twice and the numbers behind it.
         for (ext, least) in [("png", 1000), ("svg", 1000), ("json", 1)] {

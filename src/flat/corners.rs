@@ -40,7 +40,9 @@ impl CornerGrid {
         }
         let extent = (hi - lo).max(DVec2::splat(1e-12 * (hi - lo).max_element().max(1e-300)));
         let cells_wanted = (corners.len() as f64 / 2.0).max(1.0);
-        let cell = (extent.x * extent.y / cells_wanted).sqrt().max(extent.max_element() / 4096.0);
+        let cell = (extent.x * extent.y / cells_wanted)
+            .sqrt()
+            .max(extent.max_element() / 4096.0);
         let nx = ((extent.x / cell).ceil() as usize).clamp(1, 4096);
         let ny = ((extent.y / cell).ceil() as usize).clamp(1, 4096);
         let mut grid = CornerGrid {
@@ -147,7 +149,12 @@ mod tests {
             .collect();
         let grid = CornerGrid::new(&corners);
         for _ in 0..300 {
-            let mut p = || DVec2::new(rng.random::<f64>() * 6.0 - 2.0, rng.random::<f64>() * 3.0 - 0.5);
+            let mut p = || {
+                DVec2::new(
+                    rng.random::<f64>() * 6.0 - 2.0,
+                    rng.random::<f64>() * 3.0 - 0.5,
+                )
+            };
             let (a, b, c) = (p(), p(), p());
             let mut found = Vec::new();
             grid.near_triangle(a, b, c, |i| {

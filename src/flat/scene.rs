@@ -3,10 +3,10 @@
 //! sensitivities are wanted, and the sensor. [`Scene::new`] validates
 //! everything a user can get wrong (the book's "Flatland" chapter lists the
 //! rules); the path tracer then never meets a degenerate configuration.
+use super::corners::CornerGrid;
 use super::geometry::{
     LinearScan, NO_SEGMENT, RayCast, Segment, contains, cross, perp, signed_area,
 };
-use super::corners::CornerGrid;
 use crate::error::Error;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -500,9 +500,8 @@ impl Scene {
             .filter(|(_, s)| s.surface.is_opaque())
             .flat_map(|(k, s)| s.vertices.iter().map(move |&v| (v, k as u32)))
             .collect::<Vec<(DVec2, u32)>>();
-        let corner_grid = (corners.len() > GRID_THRESHOLD).then(|| {
-            CornerGrid::new(&corners.iter().map(|c| c.0).collect::<Vec<_>>())
-        });
+        let corner_grid = (corners.len() > GRID_THRESHOLD)
+            .then(|| CornerGrid::new(&corners.iter().map(|c| c.0).collect::<Vec<_>>()));
         Ok(Scene {
             caster: caster(segments.clone()),
             opaque: caster(opaque_segments.clone()),

@@ -895,10 +895,7 @@ impl Walk<'_> {
             grid.near_triangle(x, p, e, |i| {
                 let (q, k) = corners[i as usize];
                 let pq = angle(q);
-                if pq < lim
-                    && best.is_none_or(|b| pq < b.0)
-                    && super::corners::inside(x, p, e, q)
-                {
+                if pq < lim && best.is_none_or(|b| pq < b.0) && super::corners::inside(x, p, e, q) {
                     best = Some((pq, q, k));
                 }
             });

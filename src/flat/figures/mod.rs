@@ -20,6 +20,7 @@ pub mod against_pi;
 pub mod convergence;
 pub mod efficiency;
 pub mod scene;
+pub mod stability;
 pub mod warp;
 
 /// The Monte Carlo methods in the figures' order.
@@ -55,12 +56,13 @@ pub const REFERENCE_COLOR: usize = 6;
 
 /// Every flatland figure, in the book's order; returns the files written.
 pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let figures: [FigureFn; 5] = [
+    let figures: [FigureFn; 6] = [
         scene::scene,
         warp::warp,
         against_pi::against_pi,
         convergence::convergence,
         efficiency::efficiency,
+        stability::stability,
     ];
     let mut written = Vec::new();
     for figure in figures {
