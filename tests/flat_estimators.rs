@@ -190,3 +190,40 @@ fn results_do_not_depend_on_the_thread_count() {
         assert_eq!(one.estimates, two.estimates, "{}", method.name());
     }
 }
+
+#[test]
+fn next_event_estimation_agrees_with_plain_path_tracing() {
+    // The intensity estimator connects every collision and reflection (and
+    // an irradiance sensor) to a point drawn on the lamps, weighted against
+    // the lobe by multiple importance sampling; the derivative walks find
+    // lamps only by hitting them. Two independent estimators of I.
+    for name in [
+        "fog.toml",
+        "reflector.toml",
+        "submerged.toml",
+        "radiance.toml",
+        "three_shapes.toml",
+    ] {
+        let scene = scene(name);
+        let nee = get(
+            &estimate(Method::Intensity, &scene, 1_000_000, 31),
+            &scene,
+            None,
+        );
+        let plain = get(
+            &estimate(Method::Expectation, &scene, 1_000_000, 32),
+            &scene,
+            None,
+        );
+        let z = (nee.mean - plain.mean).abs() / (nee.stderr.powi(2) + plain.stderr.powi(2)).sqrt();
+        eprintln!("{name}: NEE {nee:?} plain {plain:?} z = {z:.2}");
+        assert!(
+            z < 4.0,
+            "{name}: NEE {nee:?} vs plain {plain:?} (z = {z:.2})"
+        );
+        assert!(
+            nee.stderr < plain.stderr,
+            "{name}: NEE does not serve: {nee:?} vs {plain:?}"
+        );
+    }
+}

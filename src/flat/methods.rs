@@ -10,7 +10,7 @@
 //!   pair of displaced scenes per parameter.
 use super::geometry::NO_SEGMENT;
 use super::scene::{Scene, Sensor};
-use super::trace::{cosine_direction, radiance};
+use super::trace::{Lobe, cosine_direction, next_event, radiance, radiance_observed};
 use super::walk::{Scheme, Slots, Walk};
 use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
@@ -96,8 +96,13 @@ fn reading(scene: &Scene, rng: &mut PathRng) -> f64 {
             radiance(scene, rng, x, direction, medium, NO_SEGMENT)
         }
         Sensor::Irradiance { normal, .. } => {
+            // ∫ L (ω·n)⁺ dθ = 2 × (the cosine lobe's normalised integral).
+            let lobe = Lobe::Cosine(normal);
+            let direct = next_event(scene, rng, x, medium, NO_SEGMENT, lobe);
             let w = cosine_direction(normal, rng);
-            2.0 * radiance(scene, rng, x, w, medium, NO_SEGMENT)
+            let pdf = lobe.pdf(w);
+            2.0 * (direct
+                + radiance_observed(scene, rng, x, w, medium, NO_SEGMENT, Some(pdf), &mut |_| {}))
         }
     }
 }

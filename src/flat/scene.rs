@@ -236,6 +236,10 @@ pub struct Scene {
     opaque_owner: Vec<u32>,
     /// The corners bucketed for triangle queries (many corners only).
     corner_grid: Option<CornerGrid>,
+    /// Emitting segments with their cumulative length (for next-event
+    /// estimation), and the total length.
+    emitters: Vec<(u32, f64)>,
+    emitter_length: f64,
     /// Vertices of opaque shapes with their shape: where the integrand over
     /// directions seen from a point can jump.
     corners: Vec<(DVec2, u32)>,
@@ -502,7 +506,19 @@ impl Scene {
             .collect::<Vec<(DVec2, u32)>>();
         let corner_grid = (corners.len() > GRID_THRESHOLD)
             .then(|| CornerGrid::new(&corners.iter().map(|c| c.0).collect::<Vec<_>>()));
+        let mut emitters = Vec::new();
+        let mut emitter_length = 0.0;
+        for (i, seg) in segments.iter().enumerate() {
+            if let Surface::Emitter { radiance } = shapes[owner[i] as usize].surface
+                && radiance > 0.0
+            {
+                emitter_length += seg.length();
+                emitters.push((i as u32, emitter_length));
+            }
+        }
         Ok(Scene {
+            emitters,
+            emitter_length,
             caster: caster(segments.clone()),
             opaque: caster(opaque_segments.clone()),
             opaque_index,
@@ -618,6 +634,28 @@ impl Scene {
     /// [`GRID_THRESHOLD`] corners.
     pub fn corner_grid(&self) -> Option<&CornerGrid> {
         self.corner_grid.as_ref()
+    }
+    /// A point drawn uniformly (by length) on the emitting segments from a
+    /// uniform number `u ∈ [0, 1)`: the point, its segment; `None` without
+    /// emitters.
+    #[inline]
+    pub fn emitter_point(&self, u: f64) -> Option<(DVec2, u32)> {
+        let (&(_, total), _) = self.emitters.split_last()?;
+        let s = u * total;
+        let i = self
+            .emitters
+            .partition_point(|e| e.1 <= s)
+            .min(self.emitters.len() - 1);
+        let (seg, end) = self.emitters[i];
+        let segment = self.segments[seg as usize];
+        let len = segment.length();
+        let along = ((s - (end - len)) / len).clamp(0.0, 1.0);
+        Some((segment.a + along * (segment.b - segment.a), seg))
+    }
+    /// Total length of the emitting segments.
+    #[inline]
+    pub fn emitter_length(&self) -> f64 {
+        self.emitter_length
     }
     /// Vertices of opaque shapes, with their shape.
     pub fn corners(&self) -> &[(DVec2, u32)] {

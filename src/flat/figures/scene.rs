@@ -289,6 +289,7 @@ pub fn sample_paths(scene: &Scene, seed: u64) -> Vec<PathRecord> {
                     w,
                     scene.sensor_medium(),
                     NO_SEGMENT,
+                    None,
                     &mut |v| vertices.push([v.x, v.y]),
                 );
             PathRecord { vertices, weight }
