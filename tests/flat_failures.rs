@@ -4,63 +4,24 @@
 //! reference or finite differences. The book's "Where the methods fail"
 //! section shows the same numbers.
 use geosens::flat::exact::Reference;
-use geosens::flat::{Medium, Method, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface};
+use geosens::flat::figures::stability;
+use geosens::flat::{Method, Scene};
 use geosens::{Estimate, Quantity, RunConfig, run};
-use glam::DVec2;
 use std::sync::Arc;
-
-fn lamp() -> Shape {
-    Shape {
-        name: "lamp".into(),
-        vertices: vec![DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0)],
-        closed: false,
-        surface: Surface::Emitter { radiance: 1.0 },
-        medium: None,
-    }
-}
-
-fn tx(shape: &str) -> Parameter {
-    Parameter {
-        name: "tx".into(),
-        shape: shape.into(),
-        motion: Motion::TranslateX,
-    }
-}
-
-fn up(point: DVec2) -> Sensor {
-    Sensor::Irradiance {
-        point,
-        normal: DVec2::Y,
-    }
-}
 
 /// `∂E/∂tx`: estimate and per-path variance `σ² N`.
 fn sensitivity(method: Method, scene: &Arc<Scene>, paths: u64) -> (Estimate, f64) {
     let e = method.estimator(scene.clone()).unwrap();
     let r = run(e.as_ref(), &RunConfig::new(paths, 7).unwrap()).unwrap();
-    let s = r.get(&Quantity::sensitivity("tx")).unwrap();
+    let s = r.get(&Quantity::sensitivity("p")).unwrap();
     (s, s.stderr * s.stderr * paths as f64)
 }
 
-/// The occluder's left corner seen `gap` (along x at y = 1) to the right of
-/// the lamp's left end, which the sensor at the origin sees in the same
-/// direction when `gap = 0`.
+/// The occluder's left corner seen `gap` (along x at y = 1) inside the
+/// lamp's left end, which the sensor at the origin sees in the same direction
+/// when `gap = 0` (the stability figure's first case).
 fn aligned_corners(gap: f64) -> Arc<Scene> {
-    let occluder = Shape {
-        name: "occluder".into(),
-        vertices: vec![DVec2::new(-0.5 + gap, 1.0), DVec2::new(0.2, 1.0)],
-        closed: false,
-        surface: Surface::Absorber,
-        medium: None,
-    };
-    Arc::new(
-        Scene::new(
-            vec![lamp(), occluder],
-            vec![tx("occluder")],
-            up(DVec2::ZERO),
-        )
-        .unwrap(),
-    )
+    Arc::new(stability::knots(gap).unwrap())
 }
 
 #[test]
@@ -90,25 +51,10 @@ fn expectation_variance_grows_as_two_warp_knots_meet() {
     );
 }
 
-/// A sensor inside a moving absorbing fog, `d` from its left edge.
+/// A sensor inside a moving absorbing box, `d` from its left edge (the
+/// stability figure's second case).
 fn sensor_near_moving_edge(d: f64) -> Arc<Scene> {
-    let fog = Shape {
-        name: "fog".into(),
-        vertices: vec![
-            DVec2::new(-d, -0.5),
-            DVec2::new(1.5, -0.5),
-            DVec2::new(1.5, 1.5),
-            DVec2::new(-d, 1.5),
-        ],
-        closed: true,
-        surface: Surface::Transparent,
-        medium: Some(Medium {
-            ks: 0.0,
-            ke: 1.0,
-            phase: Phase::Isotropic,
-        }),
-    };
-    Arc::new(Scene::new(vec![lamp(), fog], vec![tx("fog")], up(DVec2::ZERO)).unwrap())
+    Arc::new(stability::sensor_near_edge(d).unwrap())
 }
 
 #[test]

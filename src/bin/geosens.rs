@@ -252,6 +252,22 @@ struct JsonLine<'a> {
     seconds: f64,
 }
 
+/// Refuses a result with a non-finite estimate: serde_json would print a
+/// NaN as `null`, indistinguishable from "not estimated".
+fn all_finite(result: &RunResult) -> Result<(), String> {
+    match result
+        .estimates
+        .iter()
+        .find(|(_, e)| !(e.mean.is_finite() && e.stderr.is_finite()))
+    {
+        Some((q, e)) => Err(format!(
+            "method {} gives {q} = {} ± {} at these inputs (floating-point overflow)",
+            result.method, e.mean, e.stderr
+        )),
+        None => Ok(()),
+    }
+}
+
 /// `geosens rod`.
 fn rod_command(args: &RodArgs, out: &mut impl Write) -> Result<(), Box<dyn std::error::Error>> {
     let rod = Rod::new(args.ks, args.ke, args.length)?;
@@ -261,19 +277,7 @@ fn rod_command(args: &RodArgs, out: &mut impl Write) -> Result<(), Box<dyn std::
         Some(m) => run(m.estimator(rod, probe).as_ref(), &cfg)?,
         None => exact_result(&rod, &probe),
     };
-    // serde_json would print a NaN as `null`, indistinguishable from "not
-    // estimated": refuse instead.
-    if let Some((q, e)) = result
-        .estimates
-        .iter()
-        .find(|(_, e)| !(e.mean.is_finite() && e.stderr.is_finite()))
-    {
-        return Err(format!(
-            "method {} gives {q} = {} ± {} at these inputs (floating-point overflow)",
-            result.method, e.mean, e.stderr
-        )
-        .into());
-    }
+    all_finite(&result)?;
     if args.json {
         let [i, s, g] = quantities().map(|q| {
             result.get(&q).map(|e| MeanErr {
@@ -503,17 +507,7 @@ fn flat_command(args: &FlatArgs, out: &mut impl Write) -> Result<(), Box<dyn std
     };
     let cfg = args.run.config(1_000_000)?;
     let result = run(method.estimator(scene.clone())?.as_ref(), &cfg)?;
-    if let Some((q, e)) = result
-        .estimates
-        .iter()
-        .find(|(_, e)| !(e.mean.is_finite() && e.stderr.is_finite()))
-    {
-        return Err(format!(
-            "method {} gives {q} = {} ± {} (floating-point overflow)",
-            result.method, e.mean, e.stderr
-        )
-        .into());
-    }
+    all_finite(&result)?;
     if args.json {
         let value = |e: &Estimate| {
             serde_json::to_value(MeanErr {

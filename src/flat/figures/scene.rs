@@ -460,7 +460,11 @@ fn legend() -> Panel {
     let mut series = surface_legend(ALL_SURFACES);
     series.extend([
         Series::polygon("sensor", colors::SENSOR, vec![], 1.0),
-        Series::thin("path carrying light (lamp hit or connection)", colors::LIT, vec![]),
+        Series::thin(
+            "path carrying light (lamp hit or connection)",
+            colors::LIT,
+            vec![],
+        ),
         Series::thin("path carrying none", colors::DARK, vec![]),
         Series::points("path meets a moving boundary", colors::MARK, vec![]),
         Series::circles("moving silhouette corner in view", colors::MARK, vec![]),
