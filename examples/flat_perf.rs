@@ -5,6 +5,11 @@
 //!
 //! `cargo run --release --example flat_perf -- [ROUNDS] [PATHS]`: medians of
 //! ROUNDS (default 5) one-thread runs of PATHS paths (default 200000).
+//!
+//! Two baselines: `intensity` (the intensity estimator, with next-event
+//! estimation; `cost/int`) and `plain`, the derivative walk on the scene
+//! stripped of its parameters: the same paths traced with no derivative and
+//! no next-event estimation (`cost/plain`).
 use geosens::flat::{Method, Motion, Parameter, Scene, Sensor, Shape, Surface, file};
 use geosens::{RunConfig, run};
 use glam::DVec2;
@@ -65,29 +70,39 @@ fn main() {
     ];
     println!("{rounds} rounds of {paths} paths, one thread; medians");
     println!(
-        "{:<14} {:>4} {:<12} {:>12} {:>10}",
-        "scene", "par", "method", "paths/s", "cost/int"
+        "{:<14} {:>4} {:<12} {:>12} {:>9} {:>10}",
+        "scene", "par", "method", "paths/s", "cost/int", "cost/plain"
     );
     for (name, scene) in &scenes {
         let cfg = RunConfig::new(paths, 1).unwrap().threads(1);
-        let mut intensity = f64::NAN;
-        for m in methods {
-            let e = m.estimator(scene.clone()).unwrap();
-            let mut t: Vec<f64> = (0..rounds)
-                .map(|_| run(e.as_ref(), &cfg).unwrap().seconds)
-                .collect();
+        let median = |e: &dyn geosens::Estimator| {
+            let mut t: Vec<f64> = (0..rounds).map(|_| run(e, &cfg).unwrap().seconds).collect();
             t.sort_by(f64::total_cmp);
-            let median = t[t.len() / 2];
-            if m == Method::Intensity {
-                intensity = median;
-            }
+            t[t.len() / 2]
+        };
+        let bare =
+            Arc::new(Scene::new(scene.shapes().to_vec(), Vec::new(), scene.sensor()).unwrap());
+        let plain = median(Method::Expectation.estimator(bare).unwrap().as_ref());
+        let intensity = median(Method::Intensity.estimator(scene.clone()).unwrap().as_ref());
+        println!(
+            "{:<14} {:>4} {:<12} {:>12.3e} {:>9.2} {:>10.2}",
+            name,
+            0,
+            "plain",
+            paths as f64 / plain,
+            plain / intensity,
+            1.0
+        );
+        for m in methods {
+            let t = median(m.estimator(scene.clone()).unwrap().as_ref());
             println!(
-                "{:<14} {:>4} {:<12} {:>12.3e} {:>10.2}",
+                "{:<14} {:>4} {:<12} {:>12.3e} {:>9.2} {:>10.2}",
                 name,
                 scene.parameters().len(),
                 m.name(),
-                paths as f64 / median,
-                median / intensity
+                paths as f64 / t,
+                t / intensity,
+                t / plain
             );
         }
     }

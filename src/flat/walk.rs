@@ -640,6 +640,10 @@ impl Walk<'_> {
         beta: f64,
         at_sensor: bool,
     ) -> DVec2 {
+        if n == 0 {
+            // Nothing to differentiate: plain tracing.
+            return lobe.sample(rng);
+        }
         match self.scheme {
             Scheme::Rendering | Scheme::Transport => {
                 self.corner_jump(rng, d, n, x, medium, skip, lobe, spin, beta);
