@@ -22,6 +22,9 @@ use serde::Serialize;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ChunkSums {
     n: u64,
+    /// Zero weights, counted apart: most sensitivity weights of a path are
+    /// exactly zero, and they need no arithmetic in the hot loop.
+    zeros: u64,
     shift: f64,
     s1: f64,
     s2: f64,
@@ -35,6 +38,10 @@ impl ChunkSums {
     /// Adds one weight.
     #[inline]
     pub fn push(&mut self, w: f64) {
+        if w == 0.0 {
+            self.zeros += 1;
+            return;
+        }
         if self.n == 0 {
             self.shift = w;
         }
@@ -52,18 +59,31 @@ impl ChunkSums {
 
     /// Central moments of the chunk.
     pub fn moments(&self) -> Moments {
+        let total = self.n + self.zeros;
         if self.n == 0 {
-            return Moments::default();
+            return Moments {
+                n: total,
+                ..Moments::default()
+            };
         }
-        let n = self.n as f64;
-        let m = self.s1 / n;
+        // Each zero weight is `d = −shift` from the shift.
+        let (z, c) = (self.zeros as f64, self.shift);
+        let c2 = c * c;
+        let (s1, s2, s3, s4) = (
+            self.s1 - z * c,
+            self.s2 + z * c2,
+            self.s3 - z * c2 * c,
+            self.s4 + z * c2 * c2,
+        );
+        let n = total as f64;
+        let m = s1 / n;
         let m2 = m * m;
         Moments {
-            n: self.n,
+            n: total,
             mean: self.shift + m,
-            m2: (self.s2 - n * m2).max(0.0),
-            m3: self.s3 - 3.0 * m * self.s2 + 2.0 * n * m2 * m,
-            m4: (self.s4 - 4.0 * m * self.s3 + 6.0 * m2 * self.s2 - 3.0 * n * m2 * m2).max(0.0),
+            m2: (s2 - n * m2).max(0.0),
+            m3: s3 - 3.0 * m * s2 + 2.0 * n * m2 * m,
+            m4: (s4 - 4.0 * m * s3 + 6.0 * m2 * s2 - 3.0 * n * m2 * m2).max(0.0),
             max_abs: self.max_abs,
             sum_abs: self.sum_abs,
         }

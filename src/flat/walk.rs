@@ -72,6 +72,8 @@ pub(crate) struct Slots {
     /// The corners visible from an irradiance sensor in front of it, by
     /// angle from +x: the warp's knots there, the same for every path.
     pub sensor_knots: Vec<Knot>,
+    /// Per shape, the slots that move it (bit `j` for slot `j`).
+    pub shape_slots: Vec<u32>,
 }
 
 impl Slots {
@@ -96,7 +98,12 @@ impl Slots {
             Sensor::Radiance { .. } => Vec::new(),
         };
         sensor_knots.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut shape_slots = vec![0u32; scene.shapes().len()];
+        for j in 0..params {
+            shape_slots[scene.parameter_shape(j) as usize] |= 1 << j;
+        }
         Slots {
+            shape_slots,
             params,
             gradient,
             moving_corners,
@@ -230,6 +237,21 @@ struct Deriv {
     score: [f64; MAX_SLOTS],
     /// Boundary terms collected so far.
     boundary: [f64; MAX_SLOTS],
+    /// Slots whose `u`, `φ̇` or score may be non-zero: the others are
+    /// skipped (their updates would add exact zeros).
+    live: u32,
+}
+
+/// The slots set in `mask`.
+#[inline]
+fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let j = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            j
+        })
+    })
 }
 
 /// How slot `j`'s path deforms.
@@ -250,6 +272,7 @@ impl Deriv {
             phid: [0.0; MAX_SLOTS],
             score: [0.0; MAX_SLOTS],
             boundary: [0.0; MAX_SLOTS],
+            live: 0,
         }
     }
 }
@@ -285,6 +308,16 @@ impl Walk<'_> {
         }
     }
 
+    /// The slots that move shape `k` (none in the frozen scene).
+    #[inline]
+    fn moves(&self, k: u32) -> u32 {
+        if self.frozen {
+            0
+        } else {
+            self.slots.shape_slots[k as usize]
+        }
+    }
+
     /// Turning rate of shape `k` for slot `j`.
     #[inline]
     fn spin(&self, j: usize, k: u32) -> f64 {
@@ -303,6 +336,9 @@ impl Walk<'_> {
         let mut d = Deriv::new();
         for j in 0..n {
             d.u[j] = self.slots.sensor_velocity(j);
+            if d.u[j] != DVec2::ZERO {
+                d.live |= 1 << j;
+            }
         }
         let x = scene.sensor().point();
         let medium = scene.sensor_medium();
@@ -338,8 +374,13 @@ impl Walk<'_> {
     ) -> f64 {
         let scene = self.scene;
         let mut intensity = 0.0;
-        let mut tb_dot = [0.0; MAX_SLOTS];
+        let mut tb_dot: [f64; MAX_SLOTS];
         let mut depth = 0u32;
+        for j in 0..n {
+            if d.u[j] != DVec2::ZERO || d.phid[j] != 0.0 || d.score[j] != 0.0 {
+                d.live |= 1 << j;
+            }
+        }
         loop {
             let hit = scene.cast(x, w, skip);
             let wp = perp(w);
@@ -351,12 +392,16 @@ impl Walk<'_> {
                 let k = scene.owner(h.segment);
                 let nb = scene.normal(h.segment);
                 let wn = w.dot(nb);
-                for j in 0..n {
+                tb_dot = [0.0; MAX_SLOTS];
+                for j in bits(d.live | self.moves(k)) {
                     let v = self.velocity(j, k, y);
                     tb_dot[j] = (v - d.u[j] - h.t * d.phid[j] * wp).dot(nb) / wn;
+                    if tb_dot[j] != 0.0 {
+                        d.live |= 1 << j;
+                    }
                 }
             } else {
-                tb_dot[..n].fill(0.0);
+                tb_dot = [0.0; MAX_SLOTS];
             }
             if let Some(m) = scene.medium(medium) {
                 let leibniz = (0..n).any(|j| self.rule(j) == Rule::Fixed && tb_dot[j] != 0.0);
@@ -370,7 +415,7 @@ impl Walk<'_> {
                     let wi = phase_direction(m.phase, w, rng);
                     let ls = radiance(scene, rng, end, wi, medium, NO_SEGMENT);
                     let term = beta * m.ks * (-m.ke * t_b).exp() * ls;
-                    for j in 0..n {
+                    for j in bits(d.live) {
                         if self.rule(j) == Rule::Fixed {
                             d.boundary[j] += term * tb_dot[j];
                         }
@@ -380,7 +425,7 @@ impl Walk<'_> {
                 let ka = m.ke - m.ks;
                 if xi < t_b {
                     beta *= (-ka * xi).exp();
-                    for j in 0..n {
+                    for j in bits(d.live) {
                         let xi_dot = match self.rule(j) {
                             Rule::Stretch => {
                                 d.score[j] += tb_dot[j] / t_b;
@@ -406,7 +451,7 @@ impl Walk<'_> {
                     continue;
                 }
                 beta *= (-ka * t_b).exp();
-                for j in 0..n {
+                for j in bits(d.live) {
                     if self.rule(j) != Rule::Euler {
                         d.score[j] -= m.ke * tb_dot[j];
                     }
@@ -414,7 +459,7 @@ impl Walk<'_> {
             }
             let Some(h) = hit else { break };
             let before = x;
-            for j in 0..n {
+            for j in bits(d.live) {
                 if self.rule(j) != Rule::Euler {
                     d.u[j] += tb_dot[j] * w + h.t * d.phid[j] * wp;
                 }
@@ -430,7 +475,7 @@ impl Walk<'_> {
                     }
                     let contribution = beta * radiance;
                     intensity += contribution;
-                    for j in 0..n {
+                    for j in bits(d.live) {
                         d.boundary[j] += contribution * d.score[j];
                     }
                     break;
@@ -526,6 +571,9 @@ impl Walk<'_> {
         };
         for j in 0..n {
             d.u[j] = self.slots.sensor_velocity(j);
+            if d.u[j] != DVec2::ZERO {
+                d.live |= 1 << j;
+            }
         }
         let at_sensor = matches!(self.scene.sensor(), Sensor::Irradiance { .. });
         self.warp(
@@ -649,6 +697,11 @@ impl Walk<'_> {
                 self.corner_jump(rng, d, n, x, medium, skip, lobe, spin, beta);
                 let w = lobe.sample(rng);
                 d.phid[..n].copy_from_slice(&spin[..n]);
+                for j in 0..n {
+                    if spin[j] != 0.0 {
+                        d.live |= 1 << j;
+                    }
+                }
                 w
             }
             Scheme::Expectation => {
@@ -686,7 +739,13 @@ impl Walk<'_> {
         let corners = scene.corners();
         // A vertex that stays put in a frame that stays put sees only the
         // corners of moving shapes move.
-        let moving = (0..n).any(|j| d.u[j] != DVec2::ZERO || spin[j] != 0.0);
+        let mut turning = 0u32;
+        for j in 0..n {
+            if d.u[j] != DVec2::ZERO || spin[j] != 0.0 {
+                turning |= 1 << j;
+            }
+        }
+        let moving = turning != 0;
         let count = if moving {
             corners.len()
         } else {
@@ -708,7 +767,8 @@ impl Walk<'_> {
         }
         let mut rates = [0.0; MAX_SLOTS];
         let mut any = false;
-        for j in 0..n {
+        let slots = turning | self.moves(k);
+        for j in bits(slots) {
             rates[j] = self.corner_rate(j, x, d.u[j], q, k) - spin[j];
             any |= rates[j] != 0.0;
         }
@@ -733,7 +793,7 @@ impl Walk<'_> {
         );
         // d/dπ ∫ f L dφ ∋ (f L)(φ_q⁻) φ̇_q − (f L)(φ_q⁺) φ̇_q.
         let term = beta * f * (minus - plus) * count as f64;
-        for j in 0..n {
+        for j in bits(slots) {
             d.boundary[j] += term * rates[j];
         }
     }
@@ -760,7 +820,19 @@ impl Walk<'_> {
             self.nearest_knots(x, skip, w, (h_ccw, h_cw))
         };
         let slope_log = lobe.log_slope(w);
+        // Slots with a non-zero knot value: live ones, those moving a knot's
+        // shape, those whose frame turns. The others keep V = 0.
+        let mut slots = d.live;
+        for kn in [ccw, cw].into_iter().flatten() {
+            slots |= self.moves(kn.2);
+        }
         for j in 0..n {
+            if spin[j] != 0.0 {
+                slots |= 1 << j;
+            }
+        }
+        d.live |= slots;
+        for j in bits(slots) {
             // Knot values: a corner's angular velocity, or the frame's at a
             // horizon (which keeps the integrand's domain in place).
             let (db, vb) = match ccw {
