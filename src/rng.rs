@@ -6,6 +6,8 @@
 //! algorithm may change between rand releases. The chunk seed is mixed by
 //! SplitMix64 so neighbouring `(seed, chunk)` pairs give unrelated states.
 use rand::SeedableRng;
+use rand::distr::Distribution;
+use rand_distr::Exp1;
 
 /// The generator every path draws from.
 pub type PathRng = rand_xoshiro::Xoshiro256PlusPlus;
@@ -23,6 +25,19 @@ pub fn stream(seed: u64, chunk: u64) -> PathRng {
     PathRng::seed_from_u64(mix64(
         mix64(seed) ^ chunk.wrapping_mul(0xD2B7_4407_B1CE_6E93),
     ))
+}
+
+/// A free path `ξ ~ κs e^{−κs ξ}` (the distance to the next scattering in
+/// a medium of scattering coefficient `ks`); infinite without scattering.
+/// Every scene's walk draws its free paths here.
+#[inline]
+pub fn free_path(ks: f64, rng: &mut PathRng) -> f64 {
+    if ks > 0.0 {
+        let e: f64 = Exp1.sample(rng);
+        e / ks
+    } else {
+        f64::INFINITY
+    }
 }
 
 #[cfg(test)]

@@ -6,11 +6,9 @@
 //! Book: chapter "Flatland", section "Backward path tracing".
 use super::geometry::{NO_SEGMENT, perp};
 use super::scene::{Phase, Scene, Surface};
-use crate::rng::PathRng;
+use crate::rng::{PathRng, free_path};
 use glam::DVec2;
 use rand::RngExt;
-use rand::distr::Distribution;
-use rand_distr::Exp1;
 use std::f64::consts::PI;
 
 /// Events after which Russian roulette starts.
@@ -18,17 +16,6 @@ pub(crate) const ROULETTE_DEPTH: u32 = 5;
 /// Highest survival probability of the roulette: a path in a lossless
 /// enclosure still ends.
 pub(crate) const ROULETTE_CAP: f64 = 0.95;
-
-/// A free path `ξ ~ κs e^{−κs ξ}`; infinite without scattering.
-#[inline]
-pub(crate) fn free_path(ks: f64, rng: &mut PathRng) -> f64 {
-    if ks > 0.0 {
-        let e: f64 = Exp1.sample(rng);
-        e / ks
-    } else {
-        f64::INFINITY
-    }
-}
 
 /// A direction about the unit normal `n` with density `cos θ / 2` over the
 /// half circle (so `∫ cos θ L dθ` is estimated by `2 L`).

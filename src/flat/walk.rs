@@ -31,10 +31,9 @@
 use super::geometry::{NO_SEGMENT, cross, perp};
 use super::scene::{MAX_PARAMETERS, Phase, Scene, Sensor, Surface};
 use super::trace::{
-    cosine_direction, crossed, free_path, phase_direction, phase_log_slope, phase_value, radiance,
-    survives,
+    cosine_direction, crossed, phase_direction, phase_log_slope, phase_value, radiance, survives,
 };
-use crate::rng::PathRng;
+use crate::rng::{PathRng, free_path};
 use glam::DVec2;
 use rand::RngExt;
 
@@ -896,26 +895,25 @@ impl Walk<'_> {
                     i_cw = i;
                 }
             }
-            if !done_ccw {
-                if i_ccw == usize::MAX {
-                    done_ccw = true;
-                } else if scene.visible(x, corners[i_ccw].0, skip) {
-                    done_ccw = true;
-                    ccw = Some(i_ccw);
-                } else {
-                    bound_ccw = best_ccw;
+            // A side is settled when its nearest candidate is visible or it
+            // has none; a hidden one moves that side's bound past it.
+            let settle = |done: &mut bool, i: usize, best: f64, bound: &mut f64| {
+                if *done {
+                    return None;
                 }
-            }
-            if !done_cw {
-                if i_cw == usize::MAX {
-                    done_cw = true;
-                } else if scene.visible(x, corners[i_cw].0, skip) {
-                    done_cw = true;
-                    cw = Some(i_cw);
+                if i == usize::MAX {
+                    *done = true;
+                    None
+                } else if scene.visible(x, corners[i].0, skip) {
+                    *done = true;
+                    Some(i)
                 } else {
-                    bound_cw = best_cw;
+                    *bound = best;
+                    None
                 }
-            }
+            };
+            ccw = ccw.or(settle(&mut done_ccw, i_ccw, best_ccw, &mut bound_ccw));
+            cw = cw.or(settle(&mut done_cw, i_cw, best_cw, &mut bound_cw));
         }
         let knot = |i: Option<usize>, sign: f64| {
             i.map(|i| {

@@ -11,8 +11,6 @@
 use super::{Direction, Rod, Side};
 use crate::rng::PathRng;
 use rand::Rng;
-use rand::distr::Distribution;
-use rand_distr::Exp1;
 
 /// Where and after what length a backward path left the rod.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,16 +35,7 @@ pub trait Events {
 
 impl Events for () {}
 
-/// A free path `ξ ~ κs e^{−κs ξ}`; infinite without scattering.
-#[inline]
-pub fn free_path(ks: f64, rng: &mut PathRng) -> f64 {
-    if ks > 0.0 {
-        let e: f64 = Exp1.sample(rng);
-        e / ks
-    } else {
-        f64::INFINITY
-    }
-}
+pub use crate::rng::free_path;
 
 /// An isotropic scattering direction, `±1` with probability ½ each.
 #[inline]
