@@ -45,6 +45,7 @@ pub mod error;
 pub mod estimator;
 pub mod fd;
 pub mod flat;
+pub mod path;
 pub mod plot;
 pub mod rng;
 pub mod rod;

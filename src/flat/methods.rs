@@ -2,18 +2,21 @@
 //! call samples one path (with its nested paths) and writes `I` then
 //! `∂I/∂π_j` for every declared parameter, in declaration order.
 //!
-//! - [`Method::Intensity`]: backward path tracing ([`trace`](super::trace));
+//! - [`Method::Intensity`]: backward path tracing, the path core's loop
+//!   with no hooks ([`crate::path::walk`]);
 //! - [`Method::Rendering`], [`Method::Expectation`], [`Method::Transport`]:
-//!   the differentiated walk (module `walk`) with its three bookkeepings of
-//!   the path's deformation;
+//!   the same loop with each method's hooks ([`crate::path::rendering`],
+//!   [`crate::path::expectation`], [`crate::path::transport`]) over the
+//!   plane's geometry ([`Plane`]);
 //! - [`Method::Fd`]: central differences with common random numbers, one
 //!   pair of displaced scenes per parameter.
-use super::geometry::NO_SEGMENT;
-use super::scene::{Scene, Sensor};
-use super::trace::{Lobe, cosine_direction, next_event, radiance, radiance_observed};
-use super::walk::{Scheme, Slots, Walk};
+use super::scene::Scene;
+use super::space::Plane;
 use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
+use crate::path::deform::Slots;
+use crate::path::estimator::{DerivativeEstimator, Scheme, reading};
+use crate::path::intensity::IntensityEstimator;
 use crate::rng::PathRng;
 use std::sync::Arc;
 
@@ -56,21 +59,40 @@ impl Method {
 
     /// The estimator of this method on `scene`.
     pub fn estimator(self, scene: Arc<Scene>) -> Result<Box<dyn Estimator>, Error> {
-        Ok(match self {
-            Method::Intensity => Box::new(IntensityEstimator { scene }),
-            Method::Expectation | Method::Rendering | Method::Transport => {
-                Box::new(DerivativeEstimator {
-                    slots: Slots::new(&scene, self == Method::Transport),
-                    scene,
-                    scheme: match self {
-                        Method::Expectation => Scheme::Expectation,
-                        Method::Rendering => Scheme::Rendering,
-                        _ => Scheme::Transport,
-                    },
-                })
+        let scheme = match self {
+            Method::Intensity => {
+                return Ok(Box::new(IntensityEstimator {
+                    geometry: Plane::new(scene),
+                }));
             }
-            Method::Fd => Box::new(FiniteDifference::new(scene, FD_STEP)?),
-        })
+            Method::Fd => return Ok(Box::new(FiniteDifference::new(scene, FD_STEP)?)),
+            Method::Expectation => Scheme::Expectation,
+            Method::Rendering => Scheme::Rendering,
+            Method::Transport => Scheme::Transport,
+        };
+        Ok(Box::new(derivative(scene, scheme)))
+    }
+}
+
+/// The derivative estimator of `scheme` on `scene`.
+pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plane> {
+    let gradient = scheme == Scheme::Transport;
+    let mut names: Vec<Quantity> = scene
+        .parameters()
+        .iter()
+        .map(|p| Quantity::sensitivity(&p.name))
+        .collect();
+    if gradient {
+        names.push(Quantity::gradient("x"));
+        names.push(Quantity::gradient("y"));
+    }
+    let geometry = Plane::new(scene);
+    let slots = Slots::new(&geometry, geometry.scene().shapes().len(), gradient);
+    DerivativeEstimator {
+        geometry,
+        slots,
+        scheme,
+        names,
     }
 }
 
@@ -86,87 +108,12 @@ fn sensitivities(scene: &Scene) -> Vec<Quantity> {
         .collect()
 }
 
-/// One-sample estimate of the sensor's reading.
-#[inline]
-fn reading(scene: &Scene, rng: &mut PathRng) -> f64 {
-    let x = scene.sensor().point();
-    let medium = scene.sensor_medium();
-    match scene.sensor() {
-        Sensor::Radiance { direction, .. } => {
-            radiance(scene, rng, x, direction, medium, NO_SEGMENT)
-        }
-        Sensor::Irradiance { normal, .. } => {
-            // ∫ L (ω·n)⁺ dθ = 2 × (the cosine lobe's normalised integral).
-            let lobe = Lobe::Cosine(normal);
-            let direct = next_event(scene, rng, x, medium, NO_SEGMENT, lobe);
-            let w = cosine_direction(normal, rng);
-            let pdf = lobe.pdf(w);
-            2.0 * (direct
-                + radiance_observed(scene, rng, x, w, medium, NO_SEGMENT, Some(pdf), &mut |_| {}))
-        }
-    }
-}
-
-/// Backward path tracing of the sensor's reading.
-pub struct IntensityEstimator {
-    /// The scene.
-    pub scene: Arc<Scene>,
-}
-
-impl Estimator for IntensityEstimator {
-    fn method(&self) -> &'static str {
-        "intensity"
-    }
-    fn quantities(&self) -> Vec<Quantity> {
-        vec![Quantity::Intensity]
-    }
-    #[inline]
-    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        weights[0] = reading(&self.scene, rng);
-    }
-}
-
-/// The differentiated walk: `I` and all sensitivities from one path.
-pub struct DerivativeEstimator {
-    scene: Arc<Scene>,
-    slots: Slots,
-    scheme: Scheme,
-}
-
-impl Estimator for DerivativeEstimator {
-    fn method(&self) -> &'static str {
-        match self.scheme {
-            Scheme::Rendering => "rendering",
-            Scheme::Expectation => "expectation",
-            Scheme::Transport => "transport",
-        }
-    }
-    fn quantities(&self) -> Vec<Quantity> {
-        let mut q = sensitivities(&self.scene);
-        if self.slots.gradient {
-            q.push(Quantity::gradient("x"));
-            q.push(Quantity::gradient("y"));
-        }
-        q
-    }
-    #[inline]
-    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        Walk {
-            scene: &self.scene,
-            slots: &self.slots,
-            scheme: self.scheme,
-            frozen: false,
-        }
-        .sample(rng, weights);
-    }
-}
-
 /// Central differences with common random numbers: per parameter `j`, the
 /// reading of the scene displaced by `±h_j` from copies of one generator
 /// state; `I` from the nominal scene with the same state.
 pub struct FiniteDifference {
-    scene: Arc<Scene>,
-    displaced: Vec<(Scene, Scene, f64)>,
+    nominal: Plane,
+    displaced: Vec<(Plane, Plane, f64)>,
 }
 
 impl FiniteDifference {
@@ -181,10 +128,15 @@ impl FiniteDifference {
                     super::Motion::TranslateX | super::Motion::TranslateY => h * scene.size(),
                     _ => h,
                 };
-                Ok((scene.displaced(j, step)?, scene.displaced(j, -step)?, step))
+                let plus = Plane::new(Arc::new(scene.displaced(j, step)?));
+                let minus = Plane::new(Arc::new(scene.displaced(j, -step)?));
+                Ok((plus, minus, step))
             })
             .collect::<Result<_, Error>>()?;
-        Ok(FiniteDifference { scene, displaced })
+        Ok(FiniteDifference {
+            nominal: Plane::new(scene),
+            displaced,
+        })
     }
 }
 
@@ -193,14 +145,14 @@ impl Estimator for FiniteDifference {
         "fd"
     }
     fn quantities(&self) -> Vec<Quantity> {
-        sensitivities(&self.scene)
+        sensitivities(self.nominal.scene())
     }
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
         let start = rng.clone();
-        weights[0] = reading(&self.scene, rng);
+        weights[0] = reading(&self.nominal, &mut (), rng).0;
         for (w, (plus, minus, h)) in weights[1..].iter_mut().zip(&self.displaced) {
-            let p = reading(plus, &mut start.clone());
-            let m = reading(minus, &mut start.clone());
+            let p = reading(plus, &mut (), &mut start.clone()).0;
+            let m = reading(minus, &mut (), &mut start.clone()).0;
             *w = (p - m) / (2.0 * h);
         }
     }
@@ -210,21 +162,6 @@ impl Estimator for FiniteDifference {
 /// unit of parameter `j`) of the looking direction at angle `phi` from +x,
 /// for every parameter. For an irradiance sensor, directions behind it get
 /// 0 (the field is pinned to the frame at the horizons).
-pub fn sensor_warp(scene: &Scene, phi: f64) -> Vec<f64> {
-    let slots = Slots::new(scene, false);
-    let mut out = vec![0.0; slots.len()];
-    let w = super::geometry::direction(phi);
-    if let Sensor::Irradiance { normal, .. } = scene.sensor()
-        && w.dot(normal) <= 0.0
-    {
-        return out;
-    }
-    Walk {
-        scene,
-        slots: &slots,
-        scheme: Scheme::Expectation,
-        frozen: false,
-    }
-    .sensor_warp(w, &mut out);
-    out
+pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
+    super::space::sensor_warp(plane, phi)
 }

@@ -9,8 +9,7 @@ pub mod file;
 pub mod geometry;
 pub mod methods;
 pub mod scene;
-pub mod trace;
-mod walk;
+pub mod space;
 
 pub use methods::Method;
 pub use scene::{Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface};

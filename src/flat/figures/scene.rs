@@ -17,8 +17,9 @@
 use super::{FigureOptions, load, save};
 use crate::error::Error;
 use crate::flat::geometry::{NO_SEGMENT, perp};
-use crate::flat::trace::{cosine_direction, radiance_observed};
+use crate::flat::space::{Plane, cosine_direction};
 use crate::flat::{Scene, Sensor, Surface};
+use crate::path::intensity::radiance_observed;
 use crate::plot::{Figure, Panel, Series};
 use crate::rng;
 use glam::DVec2;
@@ -274,6 +275,7 @@ pub struct SceneRecord {
 pub fn sample_paths(scene: &Scene, seed: u64) -> Vec<PathRecord> {
     let mut rng = rng::stream(seed, 0);
     let x = scene.sensor().point();
+    let plane = Plane::new(std::sync::Arc::new(scene.clone()));
     (0..PATHS)
         .map(|_| {
             let (w, factor) = match scene.sensor() {
@@ -283,14 +285,13 @@ pub fn sample_paths(scene: &Scene, seed: u64) -> Vec<PathRecord> {
             let mut vertices = vec![[x.x, x.y]];
             let weight = factor
                 * radiance_observed(
-                    scene,
+                    &plane,
                     &mut rng,
                     x,
                     w,
                     scene.sensor_medium(),
                     NO_SEGMENT,
-                    None,
-                    &mut |v| vertices.push([v.x, v.y]),
+                    |v| vertices.push([v.x, v.y]),
                 );
             PathRecord { vertices, weight }
         })

@@ -13,6 +13,7 @@ use crate::error::Error;
 use crate::flat::Scene;
 use crate::flat::geometry::{NO_SEGMENT, direction, perp};
 use crate::flat::methods::sensor_warp;
+use crate::flat::space::Plane;
 use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
 use glam::DVec2;
 use serde::Serialize;
@@ -157,7 +158,8 @@ fn arrow(a: DVec2, b: DVec2, head: f64) -> Vec<(f64, f64)> {
 /// The scene with a fan of rays from the sensor and, at each ray's end, the
 /// arrow `t V_j(φ) ω⊥` of parameter `j` (colour `color`), scaled so the
 /// longest is a tenth of the scene.
-fn arrows_panel(scene: &Scene, j: usize, color: usize, knots: &[Knot]) -> Panel {
+fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel {
+    let scene: &Scene = plane.scene();
     let view = ViewBox::of(scene, 0.08);
     let size = scene.size();
     let (x, phi_n) = frame(scene);
@@ -176,7 +178,7 @@ fn arrows_panel(scene: &Scene, j: usize, color: usize, knots: &[Knot]) -> Panel 
                 },
                 |h| h.t,
             );
-            (x + t * w, t * sensor_warp(scene, phi)[j] * perp(w))
+            (x + t * w, t * sensor_warp(plane, phi)[j] * perp(w))
         })
         .collect();
     let longest = ends.iter().map(|e| e.1.length()).fold(0.0, f64::max);
@@ -251,7 +253,8 @@ pub fn warp(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let phis: Vec<f64> = (0..CURVE_POINTS)
         .map(|i| lo + std::f64::consts::PI * i as f64 / (CURVE_POINTS - 1) as f64)
         .collect();
-    let per_phi: Vec<Vec<f64>> = phis.iter().map(|&phi| sensor_warp(&scene, phi)).collect();
+    let plane = Plane::new(std::sync::Arc::new(scene.clone()));
+    let per_phi: Vec<Vec<f64>> = phis.iter().map(|&phi| sensor_warp(&plane, phi)).collect();
     let fields = scene
         .parameters()
         .iter()
@@ -270,7 +273,7 @@ pub fn warp(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let mut panels = vec![curves_panel(&warp)];
     for name in ARROWS {
         let j = parameter(&scene, name)?;
-        panels.push(arrows_panel(&scene, j, j, &warp.knots));
+        panels.push(arrows_panel(&plane, j, j, &warp.knots));
     }
     let mut figure = Figure::new(panels, 2);
     figure.panel_size = (720, 560);

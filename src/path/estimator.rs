@@ -1,0 +1,141 @@
+//! The path core behind the crate's [`Estimator`] interface: one call
+//! samples one path from the sensor (with its nested paths and
+//! connections) and writes `I`, then `∂I/∂π_j` for every parameter in
+//! declaration order, then (transport) the sensor position's gradient.
+//! States are reused across the paths of a chunk: the hot loop allocates
+//! nothing per path.
+use super::deform::{Scratch, Slots};
+use super::expectation::Expectation;
+use super::rendering::Rendering;
+use super::transport::Transport;
+use super::walk::{Frame, Hooks, Vertex, walk};
+use super::{Boundaries, Geometry, Lobe, NO_PRIM, Sensor};
+use crate::estimator::{Estimator, Quantity};
+use crate::rng::PathRng;
+use crate::stats::ChunkSums;
+
+/// A reading of the sensor by one path: its weight, and the factor (the
+/// sensor lobe's weight) every derivative weight is multiplied by.
+#[inline]
+pub fn reading<G: Geometry, H: Hooks<G>>(g: &G, hooks: &mut H, rng: &mut PathRng) -> (f64, f64) {
+    let medium = g.sensor_medium();
+    match g.sensor() {
+        Sensor::Radiance { point, direction } => (
+            walk(g, hooks, rng, point, direction, medium, NO_PRIM, 1.0, None),
+            1.0,
+        ),
+        Sensor::Irradiance { point, normal } => {
+            let lobe = g.cosine_lobe(normal, 1.0);
+            // The walk carries the lobe's weight outside, so Russian
+            // roulette sees the same throughput as the radiance's.
+            let v = Vertex {
+                x: point,
+                medium,
+                skip: NO_PRIM,
+                lobe,
+                w_in: normal,
+                frame: Frame::Sensor,
+                beta: 1.0,
+                at_sensor: true,
+            };
+            let direct = if H::NEXT_EVENT {
+                hooks.connect(g, rng, &v)
+            } else {
+                0.0
+            };
+            let w = hooks.scatter(g, rng, &v);
+            let drawn = H::NEXT_EVENT.then(|| (lobe.pdf(w), point));
+            let scale = lobe.weight();
+            (
+                scale * (direct + walk(g, hooks, rng, point, w, medium, NO_PRIM, 1.0, drawn)),
+                scale,
+            )
+        }
+    }
+}
+
+/// Which derivative method a [`DerivativeEstimator`] runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scheme {
+    /// [`Rendering`].
+    Rendering,
+    /// [`Expectation`].
+    Expectation,
+    /// [`Transport`] (with the sensor position's gradient).
+    Transport,
+}
+
+/// `I` and every sensitivity from one path, by one derivative method.
+pub struct DerivativeEstimator<G> {
+    /// The scene.
+    pub geometry: G,
+    /// Its parameter slots.
+    pub slots: Slots,
+    /// The method.
+    pub scheme: Scheme,
+    /// Names of the parameters, then of the gradient axes.
+    pub names: Vec<Quantity>,
+}
+
+impl<G: Boundaries> DerivativeEstimator<G> {
+    /// One path's weights, states from `scratch`.
+    #[inline]
+    fn path(&self, rng: &mut PathRng, scratch: &mut Scratch<G::V>, out: &mut [f64]) {
+        let g = &self.geometry;
+        let slots = &self.slots;
+        let mut d = scratch.take(slots.len());
+        slots.start(&mut d);
+        let ((i, scale), d) = match self.scheme {
+            Scheme::Rendering => {
+                let mut h = Rendering {
+                    slots,
+                    scratch,
+                    d,
+                    frozen: false,
+                };
+                (reading(g, &mut h, rng), h.d)
+            }
+            Scheme::Expectation => {
+                let mut h = Expectation { slots, scratch, d };
+                (reading(g, &mut h, rng), h.d)
+            }
+            Scheme::Transport => {
+                let mut h = Transport::new(slots, scratch, d);
+                (reading(g, &mut h, rng), h.d)
+            }
+        };
+        out[0] = i;
+        for (o, s) in out[1..].iter_mut().zip(&d.slots) {
+            *o = scale * s.boundary;
+        }
+        scratch.give(d);
+    }
+}
+
+impl<G: Boundaries> Estimator for DerivativeEstimator<G> {
+    fn method(&self) -> &'static str {
+        match self.scheme {
+            Scheme::Rendering => "rendering",
+            Scheme::Expectation => "expectation",
+            Scheme::Transport => "transport",
+        }
+    }
+    fn quantities(&self) -> Vec<Quantity> {
+        std::iter::once(Quantity::Intensity)
+            .chain(self.names.iter().cloned())
+            .collect()
+    }
+    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
+        self.path(rng, &mut Scratch::default(), weights);
+    }
+    fn accumulate(&self, rng: &mut PathRng, paths: u64, sums: &mut [ChunkSums]) {
+        let mut w = vec![0.0; sums.len()];
+        let mut scratch = Scratch::default();
+        for _ in 0..paths {
+            self.path(rng, &mut scratch, &mut w);
+            for (s, &x) in sums.iter_mut().zip(&w) {
+                s.push(x);
+            }
+        }
+    }
+}

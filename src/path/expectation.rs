@@ -1,0 +1,116 @@
+//! Expectation differentiation: differentiate the path-space expectation
+//! along a deformation of the whole path space that carries every
+//! discontinuity with it, so `I` and every `∂I/∂π_j` come from the same
+//! paths with no boundary term and no nested path.
+//!
+//! - **Free paths** are stretched with their domain: `ξ̇ = ξ ṫ_b / t_b`,
+//!   whose divergence `ṫ_b / t_b` and the transmittance's `−κe ξ̇` enter
+//!   the score (the rod's velocity, He et al. 2024, Eq. 33);
+//! - **directions** move with the geometry's warp (2D: piecewise linear on
+//!   the circle through the angular velocities of the nearest visible
+//!   corners, pinned to the frame at the lobe's horizons); its divergence
+//!   and the lobe's `∂ ln f` along it enter the score;
+//! - **next-event estimation**: the connection's direction moves with the
+//!   same warp.
+//!
+//! Book: chapter "Flatland: one deformation, three estimators", sections
+//! "Expectation" and "The warp field".
+use super::deform::{Deform, Scratch, Slots, connect};
+use super::rendering::frame_spins;
+use super::walk::{Hooks, Vertex};
+use super::{Boundaries, Geometry, Hit, Lobe, Vector};
+use crate::rng::PathRng;
+
+/// The expectation method's hooks: one walk's deformation state.
+pub struct Expectation<'a, G: Geometry> {
+    /// What is differentiated.
+    pub slots: &'a Slots,
+    /// States for connections.
+    pub scratch: &'a mut Scratch<G::V>,
+    /// The walk's state.
+    pub d: Deform<G::V>,
+}
+
+/// Moves the direction `w` drawn at `v` with the warp: every slot's `ω̇`,
+/// and the warp's divergence plus `∂ ln f` along it added to its score.
+#[inline]
+fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>, w: G::V) {
+    let turning = frame_spins(g, slots, d, v, false);
+    let field = g.warp(v, w);
+    let mut involved = d.live.union(turning);
+    g.warp_shapes(&field, |k| involved = involved.union(slots.moving(k)));
+    for j in involved.iter() {
+        let s = &mut d.slots[j];
+        let velocity = |q: G::V, k: u32| {
+            if j < slots.params && g.parameter_shape(j) == k {
+                g.velocity(j, q)
+            } else {
+                G::V::ZERO
+            }
+        };
+        let (wd, div) = g.warp_velocity(&field, v.x, w, s.u, s.spin, velocity);
+        s.score += div + v.lobe.dlog(w, wd - G::V::turn(s.spin, w));
+        s.wd = wd;
+    }
+    for j in involved.iter() {
+        d.touch(j);
+    }
+}
+
+impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
+    #[inline]
+    fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
+        match hit {
+            Some(h) => {
+                let moving = self.slots.moving(g.shape(h.prim));
+                self.d.boundary_speed(g, h, x, w, moving);
+            }
+            None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
+        }
+    }
+    #[inline]
+    fn collision(&mut self, w: G::V, xi: f64, t_b: f64, ke: f64) {
+        // The free path stretches with its domain [0, t_b].
+        for j in self.d.live.iter() {
+            let s = &mut self.d.slots[j];
+            s.score += s.tb_dot / t_b;
+            let xi_dot = xi / t_b * s.tb_dot;
+            s.score -= ke * xi_dot;
+            s.u = s.u + w * xi_dot + s.wd * xi;
+        }
+    }
+    #[inline]
+    fn pass(&mut self, ke: f64) {
+        self.d.pass(self.slots.all(), ke);
+    }
+    #[inline]
+    fn arrive(&mut self, w: G::V, t: f64) {
+        self.d.arrive(self.slots.all(), w, t);
+    }
+    #[inline]
+    fn emission(&mut self, contribution: f64) {
+        self.d.collect(contribution);
+    }
+    #[inline]
+    fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
+        let slots = self.slots;
+        connect(
+            g,
+            slots,
+            self.scratch,
+            &mut self.d,
+            rng,
+            v,
+            false,
+            |d, w| warp(g, slots, d, v, w),
+        )
+    }
+    #[inline]
+    fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
+        let w = v.lobe.sample(rng);
+        if !self.slots.is_empty() {
+            warp(g, self.slots, &mut self.d, v, w);
+        }
+        w
+    }
+}

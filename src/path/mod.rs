@@ -1,0 +1,309 @@
+//! The differentiated path core that flatland and 3D scenes share.
+//!
+//! One event loop ([`walk`]) samples backward paths from a sensor: free
+//! paths in homogeneous media (absorption carried as a weight), surface
+//! events (emitters, black absorbers, Lambertian reflectors, transparent
+//! medium boundaries), next-event estimation with multiple importance
+//! sampling at every scattering vertex, Russian roulette. It is generic over
+//! two small traits:
+//!
+//! - [`Geometry`]: what differs between the plane and space: the vector and
+//!   direction types, ray casting, the medium lookup, lobe and phase
+//!   sampling with the log-density's derivative, emitter sampling, and how
+//!   parameters move material points and turn frames;
+//! - [`Boundaries`]: where the integrand over directions jumps (2D: the
+//!   corners of opaque shapes; 3D: silhouette edges) and the expectation
+//!   method's warp built on them.
+//!
+//! The methods are [`Hooks`] the loop calls at its events, one file each,
+//! beside their derivation in the book: [`intensity`] (no hooks: the loop
+//! alone), [`rendering`] (Leibniz and corner terms, double randomisation),
+//! [`expectation`] (stretched free paths and the warp), [`transport`]
+//! (Eulerian sources coupled to the radiance gradient). Their shared
+//! bookkeeping of the path's deformation (vertex and direction velocities,
+//! the running score) is in [`deform`]. Book: chapters "Flatland" and
+//! "Flatland: one deformation, three estimators".
+pub mod deform;
+pub mod estimator;
+pub mod expectation;
+pub mod intensity;
+pub mod rendering;
+pub mod transport;
+pub mod walk;
+
+use crate::rng::PathRng;
+use glam::{DVec2, DVec3};
+use std::ops::{Add, Mul, Neg, Sub};
+
+pub use crate::flat::scene::Surface;
+
+/// The vector type of a scene's space: points, velocities, directions and a
+/// direction's velocity (a vector tangent to the circle or the sphere).
+pub trait Vector:
+    Copy
+    + PartialEq
+    + Send
+    + Sync
+    + std::fmt::Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Neg<Output = Self>
+    + Mul<f64, Output = Self>
+{
+    /// The zero vector.
+    const ZERO: Self;
+    /// The rate at which a frame turns: an angle rate in the plane, an
+    /// angular-velocity vector in space.
+    type Spin: Copy + PartialEq + std::fmt::Debug + Send + Sync;
+    /// A frame that does not turn.
+    const STILL: Self::Spin;
+    /// Number of coordinates.
+    const DIM: usize;
+    /// The unit vector along coordinate axis `i`.
+    fn axis(i: usize) -> Self;
+    /// Scalar product.
+    fn dot(self, o: Self) -> f64;
+    /// Euclidean length.
+    fn length(self) -> f64;
+    /// The velocity of the unit direction `w` carried by a frame turning at
+    /// `spin`.
+    fn turn(spin: Self::Spin, w: Self) -> Self;
+    /// The turn rate of a frame that carries the unit direction `w` at
+    /// velocity `wd` (the smallest rotation doing so).
+    fn spin_of(w: Self, wd: Self) -> Self::Spin;
+}
+
+impl Vector for DVec2 {
+    const ZERO: Self = DVec2::ZERO;
+    type Spin = f64;
+    const STILL: f64 = 0.0;
+    const DIM: usize = 2;
+    #[inline]
+    fn axis(i: usize) -> Self {
+        [DVec2::X, DVec2::Y][i]
+    }
+    #[inline]
+    fn dot(self, o: Self) -> f64 {
+        DVec2::dot(self, o)
+    }
+    #[inline]
+    fn length(self) -> f64 {
+        DVec2::length(self)
+    }
+    #[inline]
+    fn turn(spin: f64, w: Self) -> Self {
+        spin * w.perp()
+    }
+    #[inline]
+    fn spin_of(w: Self, wd: Self) -> f64 {
+        w.perp_dot(wd)
+    }
+}
+
+impl Vector for DVec3 {
+    const ZERO: Self = DVec3::ZERO;
+    type Spin = DVec3;
+    const STILL: DVec3 = DVec3::ZERO;
+    const DIM: usize = 3;
+    #[inline]
+    fn axis(i: usize) -> Self {
+        [DVec3::X, DVec3::Y, DVec3::Z][i]
+    }
+    #[inline]
+    fn dot(self, o: Self) -> f64 {
+        DVec3::dot(self, o)
+    }
+    #[inline]
+    fn length(self) -> f64 {
+        DVec3::length(self)
+    }
+    #[inline]
+    fn turn(spin: DVec3, w: Self) -> Self {
+        spin.cross(w)
+    }
+    #[inline]
+    fn spin_of(w: Self, wd: Self) -> DVec3 {
+        w.cross(wd)
+    }
+}
+
+/// What a sensor measures at its (static) point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sensor<V> {
+    /// The radiance arriving at `point` from `direction` (where it looks).
+    Radiance {
+        /// Where.
+        point: V,
+        /// Looking direction (unit).
+        direction: V,
+    },
+    /// The irradiance `∫ L (ω·n)⁺ dω` at `point` with unit normal `normal`.
+    Irradiance {
+        /// Where.
+        point: V,
+        /// Unit normal.
+        normal: V,
+    },
+}
+
+/// A primitive (segment, triangle) index; [`NO_PRIM`] for none.
+pub type Prim = u32;
+/// No primitive (nothing to skip).
+pub const NO_PRIM: Prim = u32::MAX;
+/// A medium: the index of the shape that holds it, `None` for vacuum.
+pub type MediumId = Option<u32>;
+
+/// A closest hit along a unit ray.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f64,
+    /// The primitive hit.
+    pub prim: Prim,
+}
+
+/// The integrand over directions at a scattering vertex, up to the
+/// radiance: a cosine lobe (the irradiance sensor, a Lambertian reflector)
+/// or a phase function, with the density that samples it.
+pub trait Lobe<V: Vector>: Copy {
+    /// The integrand's factor `f(ω)`.
+    fn value(&self, w: V) -> f64;
+    /// The density with which [`Lobe::sample`] draws `w`.
+    fn pdf(&self, w: V) -> f64;
+    /// `f / pdf`, the same for every direction the lobe draws.
+    fn weight(&self) -> f64;
+    /// A direction drawn with density [`Lobe::pdf`].
+    fn sample(&self, rng: &mut PathRng) -> V;
+    /// The derivative of `ln f(ω)` when `ω` moves at `wd` relative to the
+    /// lobe's frame.
+    fn dlog(&self, w: V, wd: V) -> f64;
+}
+
+/// The media and surfaces of a scene, its rays and emitters, and its
+/// parameters' motions: what the path core needs of a geometry.
+pub trait Geometry: Sync {
+    /// Points, directions and velocities.
+    type V: Vector;
+    /// The directional lobes.
+    type Lobe: Lobe<Self::V>;
+
+    /// Largest extent of the scene (for relative offsets).
+    fn size(&self) -> f64;
+    /// What the sensor measures, and where.
+    fn sensor(&self) -> Sensor<Self::V>;
+    /// The medium around the sensor.
+    fn sensor_medium(&self) -> MediumId;
+    /// The closest primitive along the unit ray, other than `skip`.
+    fn cast(&self, x: Self::V, w: Self::V, skip: Prim) -> Option<Hit>;
+    /// Whether no opaque primitive (other than `skip`) lies strictly between
+    /// `x` and `y`.
+    fn visible(&self, x: Self::V, y: Self::V, skip: Prim) -> bool;
+    /// The shape that owns primitive `p`.
+    fn shape(&self, p: Prim) -> u32;
+    /// The surface of primitive `p`.
+    fn surface(&self, p: Prim) -> Surface;
+    /// Unit normal of primitive `p` at its point `y` (outward for closed
+    /// shapes).
+    fn normal(&self, p: Prim, y: Self::V) -> Self::V;
+    /// `(κs, κe)` of a medium.
+    fn coefficients(&self, m: MediumId) -> Option<(f64, f64)>;
+    /// The medium entered or left when a ray in `m` crosses the transparent
+    /// boundary of shape `k`.
+    fn crossed(&self, m: MediumId, k: u32) -> MediumId;
+    /// The cosine lobe `c (ω·n)⁺` about the unit normal `n`.
+    fn cosine_lobe(&self, n: Self::V, c: f64) -> Self::Lobe;
+    /// The phase function of medium `m` about the incoming direction `w`.
+    fn phase_lobe(&self, m: MediumId, w: Self::V) -> Self::Lobe;
+    /// A point drawn on the emitters from a uniform `u`: the point and its
+    /// primitive; `None` without emitters.
+    fn emitter_point(&self, u: f64) -> Option<(Self::V, Prim)>;
+    /// The density over directions at `x` of drawing the emitter point `y`
+    /// of primitive `p` with [`Geometry::emitter_point`].
+    fn light_pdf(&self, x: Self::V, y: Self::V, p: Prim) -> f64;
+    /// Number of shape parameters.
+    fn parameters(&self) -> usize;
+    /// The shape parameter `j` moves.
+    fn parameter_shape(&self, j: usize) -> u32;
+    /// Velocity `∂q/∂π_j` of the point `q` of the shape parameter `j` moves.
+    fn velocity(&self, j: usize, q: Self::V) -> Self::V;
+    /// Turn rate of that shape's frame under parameter `j`.
+    fn spin(&self, j: usize) -> <Self::V as Vector>::Spin;
+}
+
+/// A discontinuity of the integrand over directions seen from a vertex,
+/// drawn for a boundary term: a point `q` where what the ray sees changes
+/// (2D: a corner; 3D: a point on a silhouette edge) and what each side sees
+/// there.
+#[derive(Debug, Clone, Copy)]
+pub struct BoundaryPoint<V> {
+    /// The point.
+    pub q: V,
+    /// The shape it belongs to.
+    pub shape: u32,
+    /// The drawn index (the geometry's own numbering).
+    pub index: u32,
+    /// The inverse of its selection probability.
+    pub inv_pdf: f64,
+}
+
+/// What a ray just to one side of a boundary point sees there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Side {
+    /// The surface of this primitive, at the boundary point.
+    Surface(Prim),
+    /// Nothing: the ray passes the point and goes on.
+    Past,
+}
+
+/// Where the integrand over directions jumps, and the warp that follows
+/// those jumps: the discontinuity machinery of a geometry.
+pub trait Boundaries: Geometry {
+    /// Draws one boundary point for the directional integral at `x`:
+    /// among all of them when the vertex or its frame moves (`all`), else
+    /// among those of moving shapes.
+    fn sample_boundary(&self, x: Self::V, all: bool, u: f64) -> Option<BoundaryPoint<Self::V>>;
+    /// What rays just to either side of the direction from `x` to the
+    /// boundary point see there: first the side
+    /// [`Boundaries::boundary_normal`] points to (plane: counter-clockwise),
+    /// then the other.
+    fn sides(&self, x: Self::V, b: &BoundaryPoint<Self::V>) -> (Side, Side);
+    /// The unit vector tangent to the directions at `ω_q` (the direction
+    /// from `x` to the boundary point), normal to the boundary there and
+    /// pointing to the side [`Boundaries::sides`] names first.
+    fn boundary_normal(&self, x: Self::V, b: &BoundaryPoint<Self::V>) -> Self::V;
+
+    /// The expectation method's warp of the directions at a vertex: a
+    /// continuous velocity field over directions that equals each
+    /// discontinuity's velocity at the discontinuity and the frame's at the
+    /// lobe's horizon, so no boundary term is left.
+    type Warp;
+    /// The warp at `v` around the direction `w` drawn there.
+    fn warp(&self, v: &walk::Vertex<Self>, w: Self::V) -> Self::Warp
+    where
+        Self: Sized;
+    /// Calls `f` with every shape whose motion the warp at `w` follows.
+    fn warp_shapes(&self, warp: &Self::Warp, f: impl FnMut(u32));
+    /// One slot's velocity of the direction `w` under the warp, and the
+    /// warp's divergence there: `u` is the vertex velocity, `spin` the
+    /// frame's turn rate, `velocity(q, k)` the velocity of point `q` of
+    /// shape `k`.
+    fn warp_velocity(
+        &self,
+        warp: &Self::Warp,
+        x: Self::V,
+        w: Self::V,
+        u: Self::V,
+        spin: <Self::V as Vector>::Spin,
+        velocity: impl Fn(Self::V, u32) -> Self::V,
+    ) -> (Self::V, f64);
+}
+
+/// The power heuristic's weight of a strategy of density `a` against `b`.
+#[inline]
+pub fn mis(a: f64, b: f64) -> f64 {
+    if a.is_infinite() {
+        1.0
+    } else {
+        a * a / (a * a + b * b)
+    }
+}

@@ -1,0 +1,265 @@
+//! Differentiable rendering: differentiate the integral equation, its
+//! domains held fixed. Free paths keep their length and directions turn
+//! with their frame (the sensor's, a reflector's, the incoming direction at
+//! a collision), so the path deforms only through the vertices it hits;
+//! whatever moves across that fixed parametrisation is a boundary term:
+//!
+//! - the **Leibniz term** of a free-path domain `[0, t_b]` whose end moves:
+//!   `κs e^{−κe t_b} L_s(t_b⁻) ṫ_b`, `L_s` from one nested path;
+//! - the **jump** across a discontinuity of the directional integrand (a
+//!   corner seen from the vertex): `f(ω_q) T(x, q) [L_behind(q) − L_ahead(q)]
+//!   v_n`, `v_n` the discontinuity's velocity relative to the frame, one
+//!   discontinuity drawn at random and each side's radiance from one nested
+//!   path evaluated exactly at it (double randomisation);
+//! - next-event estimation: the connection's direction turns with the frame
+//!   like any other.
+//!
+//! Book: chapter "Flatland: one deformation, three estimators", sections
+//! "Rendering" and "Corner jumps".
+use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
+use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, surface_radiance};
+use super::{Boundaries, Geometry, Hit, Lobe, NO_PRIM, Side, Vector};
+use crate::rng::PathRng;
+use rand::RngExt;
+
+/// The rendering method's hooks: one walk's deformation state.
+pub struct Rendering<'a, G: Geometry> {
+    /// What is differentiated.
+    pub slots: &'a Slots,
+    /// States for connections and nested walks.
+    pub scratch: &'a mut Scratch<G::V>,
+    /// The walk's state.
+    pub d: Deform<G::V>,
+    /// The scene stands still: only the start's velocities are
+    /// differentiated (transport's gradient walks).
+    pub frozen: bool,
+}
+
+/// The slots whose material points move on shape `k` (none if `frozen`).
+#[inline]
+pub(super) fn movers(slots: &Slots, k: u32, frozen: bool) -> SlotSet {
+    if frozen {
+        SlotSet::EMPTY
+    } else {
+        slots.moving(k)
+    }
+}
+
+/// Sets every slot's `spin` to the turn rate of `v`'s frame; returns the
+/// slots whose frame turns.
+#[inline]
+pub(super) fn frame_spins<G: Geometry>(
+    g: &G,
+    slots: &Slots,
+    d: &mut Deform<G::V>,
+    v: &Vertex<G>,
+    frozen: bool,
+) -> SlotSet {
+    let mut turning = SlotSet::EMPTY;
+    for s in &mut d.slots {
+        s.spin = <G::V as Vector>::STILL;
+    }
+    match v.frame {
+        Frame::Sensor => {}
+        Frame::Surface(k) => {
+            for j in movers(slots, k, frozen).iter() {
+                let spin = g.spin(j);
+                if spin != <G::V as Vector>::STILL {
+                    d.slots[j].spin = spin;
+                    turning.insert(j);
+                }
+            }
+        }
+        Frame::Incoming => {
+            for j in d.live.iter() {
+                let s = &mut d.slots[j];
+                if s.wd != G::V::ZERO {
+                    s.spin = G::V::spin_of(v.w_in, s.wd);
+                    turning.insert(j);
+                }
+            }
+        }
+    }
+    turning
+}
+
+/// Directions attached to the frame: `ω̇ = Ω × ω` for the slots in `rule`.
+#[inline]
+pub(super) fn attach<V: Vector>(d: &mut Deform<V>, rule: SlotSet, turning: SlotSet, w: V) {
+    for j in d.live.union(turning).and(rule).iter() {
+        let s = &mut d.slots[j];
+        s.wd = V::turn(s.spin, w);
+        if s.wd != V::ZERO {
+            d.live.insert(j);
+        }
+    }
+}
+
+/// The Leibniz term of the free-path domain ending at `t_b` on a moving
+/// boundary, for the slots in `rule`: `β κs e^{−κe t_b} L_s(t_b⁻) ṫ_b`.
+#[inline]
+pub(super) fn leibniz<G: Geometry>(
+    g: &G,
+    d: &mut Deform<G::V>,
+    rule: SlotSet,
+    rng: &mut PathRng,
+    leg: &Leg<G>,
+    t_b: f64,
+) {
+    let Leg { x, w, medium, beta } = *leg;
+    let Some((ks, ke)) = g.coefficients(medium) else {
+        return;
+    };
+    let moving = d.live.and(rule);
+    if ks <= 0.0 || !moving.iter().any(|j| d.slots[j].tb_dot != 0.0) {
+        return;
+    }
+    // Just before the boundary, but farther than the caster's hit
+    // threshold even for a nested walk that starts a hair in front of it.
+    let end = x + w * (t_b - (1e-9 * g.size()).min(0.5 * t_b));
+    let wi = g.phase_lobe(medium, w).sample(rng);
+    let ls = radiance(g, rng, end, wi, medium, NO_PRIM);
+    let term = beta * ks * (-ke * t_b).exp() * ls;
+    for j in moving.iter() {
+        let s = &mut d.slots[j];
+        s.boundary += term * s.tb_dot;
+    }
+}
+
+/// The boundary term of the directional integral at `v`: one discontinuity
+/// drawn, the jump of the radiance across it evaluated exactly at it (one
+/// nested path for each side), times its velocity relative to the frame,
+/// for every slot. `spin` must hold the frame's turn rates (see
+/// [`frame_spins`]), `turning` the slots whose frame turns.
+#[inline]
+pub(super) fn corner_jump<G: Boundaries>(
+    g: &G,
+    slots: &Slots,
+    d: &mut Deform<G::V>,
+    rng: &mut PathRng,
+    v: &Vertex<G>,
+    turning: SlotSet,
+    frozen: bool,
+) {
+    // A vertex that stays put in a frame that stays put sees only the
+    // discontinuities of moving shapes move.
+    let mut moving_view = turning;
+    for j in d.live.iter() {
+        if d.slots[j].u != G::V::ZERO {
+            moving_view.insert(j);
+        }
+    }
+    let all = !moving_view.is_empty();
+    if !all && frozen {
+        return;
+    }
+    let Some(b) = g.sample_boundary(v.x, all, rng.random()) else {
+        return;
+    };
+    let r = b.q - v.x;
+    let dist = r.length();
+    let wq = r * (1.0 / dist);
+    let f = v.lobe.pdf(wq);
+    if f <= 0.0 {
+        return;
+    }
+    let Some((t, medium)) = reach(g, v.x, b.q, v.medium, v.skip) else {
+        return;
+    };
+    let normal = g.boundary_normal(v.x, &b);
+    let mut any = false;
+    let involved = moving_view.union(movers(slots, b.shape, frozen));
+    for j in involved.iter() {
+        let s = &mut d.slots[j];
+        let vq = if !frozen && j < slots.params && g.parameter_shape(j) == b.shape {
+            g.velocity(j, b.q)
+        } else {
+            G::V::ZERO
+        };
+        // The velocity of the unit direction to q, relative to the frame.
+        let rel = vq - s.u;
+        let wq_dot = (rel - wq * rel.dot(wq)) * (1.0 / dist);
+        s.tb_dot = (wq_dot - G::V::turn(s.spin, wq)).dot(normal);
+        any |= s.tb_dot != 0.0;
+    }
+    if !any {
+        return;
+    }
+    let (ahead, behind) = g.sides(v.x, &b);
+    let side = |rng: &mut PathRng, side: Side| match side {
+        Side::Surface(p) => surface_radiance(g, rng, b.q, p, wq, medium),
+        Side::Past => radiance(g, rng, b.q, wq, medium, NO_PRIM),
+    };
+    let l_ahead = side(rng, ahead);
+    let l_behind = side(rng, behind);
+    // d/dπ ∫ f L dω ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
+    let term = v.beta * f * t * (l_behind - l_ahead) * b.inv_pdf;
+    for j in involved.iter() {
+        let s = &mut d.slots[j];
+        s.boundary += term * s.tb_dot;
+        s.tb_dot = 0.0;
+    }
+}
+
+impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
+    #[inline]
+    fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
+        match hit {
+            Some(h) => {
+                let moving = movers(self.slots, g.shape(h.prim), self.frozen);
+                self.d.boundary_speed(g, h, x, w, moving);
+            }
+            None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
+        }
+    }
+    #[inline]
+    fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
+        leibniz(g, &mut self.d, self.slots.all(), rng, leg, t_b);
+    }
+    #[inline]
+    fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
+        // Fixed free path: the vertex moves with the turning direction only.
+        for j in self.d.live.iter() {
+            let s = &mut self.d.slots[j];
+            s.u = s.u + s.wd * xi;
+        }
+    }
+    #[inline]
+    fn pass(&mut self, ke: f64) {
+        self.d.pass(self.slots.all(), ke);
+    }
+    #[inline]
+    fn arrive(&mut self, w: G::V, t: f64) {
+        self.d.arrive(self.slots.all(), w, t);
+    }
+    #[inline]
+    fn emission(&mut self, contribution: f64) {
+        self.d.collect(contribution);
+    }
+    #[inline]
+    fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
+        let (slots, frozen) = (self.slots, self.frozen);
+        let turning = frame_spins(g, slots, &mut self.d, v, frozen);
+        connect(
+            g,
+            slots,
+            self.scratch,
+            &mut self.d,
+            rng,
+            v,
+            frozen,
+            |d, w| attach(d, slots.all(), turning, w),
+        )
+    }
+    #[inline]
+    fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
+        if self.slots.is_empty() {
+            return v.lobe.sample(rng);
+        }
+        let turning = frame_spins(g, self.slots, &mut self.d, v, self.frozen);
+        corner_jump(g, self.slots, &mut self.d, rng, v, turning, self.frozen);
+        let w = v.lobe.sample(rng);
+        attach(&mut self.d, self.slots.all(), turning, w);
+        w
+    }
+}

@@ -1,0 +1,256 @@
+//! The sensitivity transport model: `s_j = ∂L/∂π_j` obeys the transport
+//! equation of `L`, so for the shape-parameter slots the path stays fixed in
+//! space (Eulerian) and collects `s`'s sources where it meets a moving
+//! boundary:
+//!
+//! - at an **opaque** moving boundary hit at `y`: `−v·∇L(y⁻, ω)`, the
+//!   gradient by a nested walk in the frozen scene started just before `y`
+//!   with velocity `v` ([`Rendering`] with `frozen`);
+//! - at a moving **reflector**: the material derivative of the reflected
+//!   radiance: the corner terms seen from the moving point, and its regular
+//!   part by a nested frozen walk from the moving point in the turning frame;
+//! - at a moving **medium boundary**: the interface swaps the coefficients
+//!   of the points it sweeps, `ṫ_b [κs,b L_s,b − κs,a L_s,a − (κe,b − κe,a)
+//!   L]`, the in-scattered radiances by one nested path on each side.
+//!
+//! The sensor-position slots (`∂I/∂x`, …) follow rendering's rules.
+//! Book: chapter "Flatland: one deformation, three estimators", section
+//! "Transport".
+use super::deform::{Deform, Scratch, Slots, connect};
+use super::rendering::{Rendering, attach, corner_jump, frame_spins, leibniz};
+use super::walk::{Hooks, Leg, Vertex, radiance, walk};
+use super::{Boundaries, Geometry, Hit, MediumId, NO_PRIM, Vector};
+use crate::rng::PathRng;
+
+/// The transport method's hooks: one walk's deformation state.
+pub struct Transport<'a, G: Geometry> {
+    /// What is differentiated.
+    pub slots: &'a Slots,
+    /// States for connections and nested walks.
+    pub scratch: &'a mut Scratch<G::V>,
+    /// The walk's state.
+    pub d: Deform<G::V>,
+    /// Whether the reflector just reached moves (its material derivative is
+    /// being collected).
+    moving_reflector: bool,
+}
+
+impl<'a, G: Geometry> Transport<'a, G> {
+    /// Hooks over `d` (zeroed, sensor velocities set).
+    pub fn new(slots: &'a Slots, scratch: &'a mut Scratch<G::V>, d: Deform<G::V>) -> Self {
+        Transport {
+            slots,
+            scratch,
+            d,
+            moving_reflector: false,
+        }
+    }
+}
+
+impl<G: Boundaries> Transport<'_, G> {
+    /// Whether a shape-parameter slot's boundary moves on this segment.
+    #[inline]
+    fn euler_moving(&self) -> bool {
+        self.slots
+            .parameter_slots
+            .iter()
+            .any(|j| self.d.slots[j].tb_dot != 0.0)
+    }
+
+    /// The source `−v·∇L(y⁻, w)` where the leg hits the opaque moving
+    /// boundary of shape `k` at `y`, for every shape-parameter slot: the
+    /// gradient by a nested walk in the frozen scene started just before `y`.
+    fn surface_gradient(
+        &mut self,
+        g: &G,
+        rng: &mut PathRng,
+        leg: &Leg<G>,
+        y: G::V,
+        k: u32,
+        drawn: Option<(f64, G::V)>,
+    ) {
+        let Leg { x, w, medium, beta } = *leg;
+        let mut nested = self.scratch.take(self.d.len());
+        for j in self.slots.moving(k).iter() {
+            nested.slots[j].u = g.velocity(j, y);
+            nested.touch(j);
+        }
+        let start = y - w * (1e-9 * g.size()).min(0.5 * (y - x).length());
+        let nested = self.frozen_walk(g, rng, nested, start, w, medium, NO_PRIM, drawn);
+        for j in self.slots.parameter_slots.iter() {
+            self.d.slots[j].boundary -= beta * nested.slots[j].boundary;
+        }
+        self.scratch.give(nested);
+    }
+
+    /// A walk in the frozen scene from `x` along `w` that differentiates
+    /// the start velocities held in `nested`; returns its state. `drawn`:
+    /// how the main path drew `w`, so that a lamp it hits first carries the
+    /// main path's MIS weight (the connection estimates the rest).
+    #[allow(clippy::too_many_arguments)]
+    fn frozen_walk(
+        &mut self,
+        g: &G,
+        rng: &mut PathRng,
+        nested: Deform<G::V>,
+        x: G::V,
+        w: G::V,
+        medium: MediumId,
+        skip: u32,
+        drawn: Option<(f64, G::V)>,
+    ) -> Deform<G::V> {
+        let mut hooks = Rendering {
+            slots: self.slots,
+            scratch: self.scratch,
+            d: nested,
+            frozen: true,
+        };
+        walk(g, &mut hooks, rng, x, w, medium, skip, 1.0, drawn);
+        hooks.d
+    }
+}
+
+impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
+    #[inline]
+    fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
+        match hit {
+            Some(h) => {
+                let moving = self.slots.moving(g.shape(h.prim));
+                self.d.boundary_speed(g, h, x, w, moving);
+            }
+            None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
+        }
+    }
+    #[inline]
+    fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
+        leibniz(g, &mut self.d, self.slots.gradient_slots, rng, leg, t_b);
+    }
+    #[inline]
+    fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
+        for j in self.d.live.iter() {
+            let s = &mut self.d.slots[j];
+            s.u = s.u + s.wd * xi;
+        }
+    }
+    #[inline]
+    fn pass(&mut self, ke: f64) {
+        self.d.pass(self.slots.gradient_slots, ke);
+    }
+    #[inline]
+    fn arrive(&mut self, w: G::V, t: f64) {
+        self.d.arrive(self.slots.gradient_slots, w, t);
+    }
+    #[inline]
+    fn emission(&mut self, contribution: f64) {
+        self.d.collect(contribution);
+    }
+    #[inline]
+    fn opaque(
+        &mut self,
+        g: &G,
+        rng: &mut PathRng,
+        leg: &Leg<G>,
+        y: G::V,
+        k: u32,
+        drawn: Option<(f64, G::V)>,
+    ) {
+        if self.euler_moving() {
+            self.surface_gradient(g, rng, leg, y, k, drawn);
+        }
+    }
+    #[inline]
+    fn interface(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, y: G::V, after: MediumId) {
+        if !self.euler_moving() {
+            return;
+        }
+        let (w, before, beta) = (leg.w, leg.medium, leg.beta);
+        let eps = 1e-9 * g.size();
+        let side = |rng: &mut PathRng, medium: MediumId, at: G::V| match g.coefficients(medium) {
+            Some((ks, _)) if ks > 0.0 => {
+                let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
+                ks * radiance(g, rng, at, wi, medium, NO_PRIM)
+            }
+            _ => 0.0,
+        };
+        let ke = |medium: MediumId| g.coefficients(medium).map_or(0.0, |c| c.1);
+        let scattered = side(rng, before, y - w * eps) - side(rng, after, y + w * eps);
+        let dke = ke(before) - ke(after);
+        for j in self.slots.parameter_slots.iter() {
+            let s = &mut self.d.slots[j];
+            s.boundary += beta * s.tb_dot * scattered;
+            s.score -= dke * s.tb_dot;
+            if s.score != 0.0 {
+                self.d.live.insert(j);
+            }
+        }
+    }
+    #[inline]
+    fn reflect(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, v: &Vertex<G>, k: u32) {
+        let moving = self.slots.moving(k);
+        self.moving_reflector = !moving.is_empty();
+        if !self.moving_reflector {
+            return;
+        }
+        // The incoming radiance's gradient at the moving point first.
+        self.surface_gradient(g, rng, leg, v.x, k, None);
+        // The material derivative of the reflected radiance: the point moves
+        // with the surface (the corner terms see it move).
+        for j in moving.iter() {
+            self.d.slots[j].u = g.velocity(j, v.x);
+            self.d.touch(j);
+        }
+    }
+    #[inline]
+    fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
+        let slots = self.slots;
+        let turning = frame_spins(g, slots, &mut self.d, v, false);
+        connect(
+            g,
+            slots,
+            self.scratch,
+            &mut self.d,
+            rng,
+            v,
+            false,
+            |d, w| attach(d, slots.all(), turning, w),
+        )
+    }
+    #[inline]
+    fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
+        if self.slots.is_empty() {
+            return super::Lobe::sample(&v.lobe, rng);
+        }
+        let turning = frame_spins(g, self.slots, &mut self.d, v, false);
+        corner_jump(g, self.slots, &mut self.d, rng, v, turning, false);
+        let w = super::Lobe::sample(&v.lobe, rng);
+        attach(&mut self.d, self.slots.all(), turning, w);
+        w
+    }
+    #[inline]
+    fn reflected(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>, w: G::V) {
+        let params = self.slots.parameter_slots;
+        if self.moving_reflector {
+            // … and its regular part: the radiance reflected at the moving
+            // point in the turning frame, by a nested walk in the frozen
+            // scene; the path itself goes on fixed in space.
+            let mut nested = self.scratch.take(self.d.len());
+            for j in params.iter() {
+                let s = &mut self.d.slots[j];
+                nested.slots[j].u = s.u;
+                nested.slots[j].wd = s.wd;
+                s.u = G::V::ZERO;
+                nested.touch(j);
+            }
+            let drawn = Some((super::Lobe::pdf(&v.lobe, w), v.x));
+            let nested = self.frozen_walk(g, rng, nested, v.x, w, v.medium, v.skip, drawn);
+            for j in params.iter() {
+                self.d.slots[j].boundary += v.beta * nested.slots[j].boundary;
+            }
+            self.scratch.give(nested);
+            self.moving_reflector = false;
+        }
+        for j in params.iter() {
+            self.d.slots[j].wd = G::V::ZERO;
+        }
+    }
+}

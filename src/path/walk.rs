@@ -1,0 +1,424 @@
+//! The one event loop: backward path tracing with free paths
+//! `ξ ~ κs e^{−κs ξ}` in homogeneous media (absorption carried as the
+//! weight `e^{−κa ξ}`), surface events, next-event estimation with multiple
+//! importance sampling (power heuristic) at every scattering vertex, and
+//! Russian roulette on the throughput. The intensity estimator is this loop
+//! with the unit hooks `()`; each derivative method observes its events
+//! through [`Hooks`] and adds its own terms. Book: chapter "Flatland",
+//! sections "Backward path tracing" and "Next-event estimation".
+use super::{Geometry, Hit, Lobe, MediumId, NO_PRIM, Prim, Surface, Vector, mis};
+use crate::rng::{PathRng, free_path};
+use rand::RngExt;
+
+/// Events after which Russian roulette starts.
+pub const ROULETTE_DEPTH: u32 = 5;
+/// Highest survival probability of the roulette: a path in a lossless
+/// enclosure still ends.
+pub const ROULETTE_CAP: f64 = 0.95;
+
+/// The frame a scattering vertex's lobe is attached to: it decides how a
+/// direction drawn there turns when the parameters change.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Frame {
+    /// The sensor's, which stands still.
+    Sensor,
+    /// The surface of shape `k` (a reflector), turning with it.
+    Surface(u32),
+    /// The incoming direction's (a collision in a medium).
+    Incoming,
+}
+
+/// A straight leg of a path: from `x` along the unit `w` through `medium`,
+/// with throughput `beta` at the event that sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct Leg<G: Geometry> {
+    /// Start.
+    pub x: G::V,
+    /// Direction.
+    pub w: G::V,
+    /// Medium it runs through.
+    pub medium: MediumId,
+    /// Throughput.
+    pub beta: f64,
+}
+
+/// A scattering vertex: where it is, what it leaves, its lobe and frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Vertex<G: Geometry> {
+    /// Position.
+    pub x: G::V,
+    /// Medium it lies in.
+    pub medium: MediumId,
+    /// Primitive it lies on ([`NO_PRIM`] in a medium or at the sensor).
+    pub skip: Prim,
+    /// The directional integrand.
+    pub lobe: G::Lobe,
+    /// How its directions turn.
+    pub frame: Frame,
+    /// The direction the path arrived along.
+    pub w_in: G::V,
+    /// Throughput, the lobe's weight included: a term `f(ω) X(ω)/p(ω)`
+    /// estimated at the vertex counts `beta · pdf(ω)/p(ω) · X(ω)`.
+    pub beta: f64,
+    /// Whether this is the irradiance sensor (whose warp knots are known).
+    pub at_sensor: bool,
+}
+
+/// What a method does at the loop's events. Every method is a default
+/// no-op, so the intensity estimator (`()`) pays nothing for them.
+#[allow(unused_variables)]
+pub trait Hooks<G: Geometry> {
+    /// Whether scattering vertices connect to the lamps (next-event
+    /// estimation with MIS); without, lamps count only when hit (plain path
+    /// tracing, the reference the tests check next-event estimation with).
+    const NEXT_EVENT: bool = true;
+    /// A segment from `x` along `w` ends at `hit` (`None`: it escapes).
+    #[inline]
+    fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {}
+    /// The leg runs through its medium to a boundary at `t_b`, before its
+    /// free path is drawn.
+    #[inline]
+    fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {}
+    /// A collision at `xi < t_b` along `w` in a medium of extinction `ke`.
+    #[inline]
+    fn collision(&mut self, w: G::V, xi: f64, t_b: f64, ke: f64) {}
+    /// The segment reached its boundary through a medium of extinction `ke`.
+    #[inline]
+    fn pass(&mut self, ke: f64) {}
+    /// The vertex moves onto the boundary at distance `t` along `w`.
+    #[inline]
+    fn arrive(&mut self, w: G::V, t: f64) {}
+    /// A path vertex (figures draw paths with it).
+    #[inline]
+    fn visit(&mut self, x: G::V) {}
+    /// An emission `contribution` is collected.
+    #[inline]
+    fn emission(&mut self, contribution: f64) {}
+    /// The leg ends on the opaque surface of shape `k` at `y`; the
+    /// scattering vertex `drawn.1` drew its direction with density
+    /// `drawn.0` (`None`: a given direction).
+    #[inline]
+    fn opaque(
+        &mut self,
+        g: &G,
+        rng: &mut PathRng,
+        leg: &Leg<G>,
+        y: G::V,
+        k: u32,
+        drawn: Option<(f64, G::V)>,
+    ) {
+    }
+    /// The leg crosses the transparent boundary at `y` into `after`.
+    #[inline]
+    fn interface(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, y: G::V, after: MediumId) {}
+    /// The leg reaches the reflector of shape `k` at the vertex `v` (before
+    /// the vertex's connection and direction).
+    #[inline]
+    fn reflect(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, v: &Vertex<G>, k: u32) {}
+    /// Next-event estimation at `v`: the contribution of one emitter point.
+    #[inline]
+    fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
+        next_event(g, rng, v)
+    }
+    /// The direction leaving `v`.
+    #[inline]
+    fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
+        v.lobe.sample(rng)
+    }
+    /// The reflector's direction `w` is drawn (after [`Hooks::reflect`]).
+    #[inline]
+    fn reflected(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>, w: G::V) {}
+}
+
+impl<G: Geometry> Hooks<G> for () {}
+
+/// Russian roulette: `false` ends the path, else the throughput is divided
+/// by the survival probability.
+#[inline]
+pub fn survives(depth: u32, beta: &mut f64, rng: &mut PathRng) -> bool {
+    if depth < ROULETTE_DEPTH {
+        return true;
+    }
+    let q = beta.abs().min(ROULETTE_CAP);
+    if q <= 0.0 || rng.random::<f64>() >= q {
+        return false;
+    }
+    *beta /= q;
+    true
+}
+
+/// The lobe of a Lambertian reflector of albedo `albedo` hit along `w`:
+/// a cosine about the normal facing the arriving path.
+#[inline]
+pub fn reflector_lobe<G: Geometry>(g: &G, p: Prim, y: G::V, w: G::V, albedo: f64) -> G::Lobe {
+    let n = g.normal(p, y);
+    let n = if w.dot(n) > 0.0 { -n } else { n };
+    g.cosine_lobe(n, 0.5 * albedo)
+}
+
+/// The emitter point drawn for next-event estimation at `v`: the direction
+/// to it, its primitive, the light strategy's density there, and the
+/// connection's weight before transmittance `beta pdf(ω) Le / p_light ·
+/// w_MIS` (0 if the lobe or the emitter turns away).
+#[inline]
+pub fn light_sample<G: Geometry>(
+    g: &G,
+    rng: &mut PathRng,
+    v: &Vertex<G>,
+) -> Option<(G::V, Prim, f64)> {
+    let (y, p) = g.emitter_point(rng.random())?;
+    let d = y - v.x;
+    let w = d * (1.0 / d.length());
+    let (f, p_light) = (v.lobe.pdf(w), g.light_pdf(v.x, y, p));
+    if f <= 0.0 || !p_light.is_finite() {
+        return None;
+    }
+    let Surface::Emitter { radiance } = g.surface(p) else {
+        return None;
+    };
+    Some((w, p, v.beta * (f * radiance / p_light * mis(p_light, f))))
+}
+
+/// The transmittance along `w` from `x` (in `medium`, leaving `skip`) to
+/// the primitive `target`: `e^{−τ}` through the media crossed, 0 if an
+/// opaque primitive comes first. With `hooks`, every segment's boundary
+/// speed and transmittance derivative (the derivative walks' connections).
+#[inline]
+pub fn transmittance<G: Geometry, H: Hooks<G>>(
+    g: &G,
+    hooks: &mut H,
+    mut x: G::V,
+    w: G::V,
+    mut medium: MediumId,
+    mut skip: Prim,
+    target: Prim,
+) -> f64 {
+    let mut tau = 0.0;
+    loop {
+        let Some(h) = g.cast(x, w, skip) else {
+            return 0.0;
+        };
+        hooks.boundary(g, x, w, Some(h));
+        if let Some((_, ke)) = g.coefficients(medium) {
+            tau += ke * h.t;
+            hooks.pass(ke);
+        }
+        if h.prim == target {
+            return (-tau).exp();
+        }
+        let k = g.shape(h.prim);
+        if g.surface(h.prim) != Surface::Transparent {
+            return 0.0;
+        }
+        hooks.arrive(w, h.t);
+        x = x + w * h.t;
+        skip = h.prim;
+        medium = g.crossed(medium, k);
+    }
+}
+
+/// Next-event estimation at `v`: one point drawn on the emitters, its
+/// radiance through the media, weighted against the lobe's own sampling by
+/// the power heuristic.
+#[inline]
+pub fn next_event<G: Geometry>(g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
+    let Some((w, p, c)) = light_sample(g, rng, v) else {
+        return 0.0;
+    };
+    c * transmittance(g, &mut (), v.x, w, v.medium, v.skip, p)
+}
+
+/// One path continued from `x` along `w` with throughput `beta` (`x` in
+/// `medium`, leaving `skip`), `drawn` the density with which the last
+/// scattering vertex drew `w` and that vertex (`None`: the direction was
+/// given, so a lamp hit first counts whole). Returns the radiance it
+/// collects; `hooks` see every event.
+#[allow(clippy::too_many_arguments)]
+pub fn walk<G: Geometry, H: Hooks<G>>(
+    g: &G,
+    hooks: &mut H,
+    rng: &mut PathRng,
+    mut x: G::V,
+    mut w: G::V,
+    mut medium: MediumId,
+    mut skip: Prim,
+    mut beta: f64,
+    mut drawn: Option<(f64, G::V)>,
+) -> f64 {
+    let mut depth = 0;
+    let mut total = 0.0;
+    loop {
+        let hit = g.cast(x, w, skip);
+        let t_b = hit.map_or(f64::INFINITY, |h| h.t);
+        hooks.boundary(g, x, w, hit);
+        if let Some((ks, ke)) = g.coefficients(medium) {
+            if hit.is_some() {
+                let leg = Leg { x, w, medium, beta };
+                hooks.free_path_domain(g, rng, &leg, t_b);
+            }
+            let xi = free_path(ks, rng);
+            if xi < t_b {
+                beta *= (-(ke - ks) * xi).exp();
+                hooks.collision(w, xi, t_b, ke);
+                x = x + w * xi;
+                hooks.visit(x);
+                let v = Vertex {
+                    x,
+                    medium,
+                    skip: NO_PRIM,
+                    lobe: g.phase_lobe(medium, w),
+                    w_in: w,
+                    frame: Frame::Incoming,
+                    beta,
+                    at_sensor: false,
+                };
+                if H::NEXT_EVENT {
+                    total += hooks.connect(g, rng, &v);
+                }
+                w = hooks.scatter(g, rng, &v);
+                drawn = H::NEXT_EVENT.then(|| (v.lobe.pdf(w), x));
+                skip = NO_PRIM;
+                depth += 1;
+                if !survives(depth, &mut beta, rng) {
+                    return total;
+                }
+                continue;
+            }
+            beta *= (-(ke - ks) * t_b).exp();
+            hooks.pass(ke);
+        }
+        let Some(h) = hit else {
+            // Leaving the scene: the path's last leg, cut at the scene's size.
+            hooks.visit(x + w * (2.0 * g.size()));
+            return total;
+        };
+        hooks.arrive(w, h.t);
+        let leg = Leg { x, w, medium, beta };
+        x = x + w * h.t;
+        hooks.visit(x);
+        skip = h.prim;
+        let k = g.shape(h.prim);
+        match g.surface(h.prim) {
+            Surface::Emitter { radiance } => {
+                hooks.opaque(g, rng, &leg, x, k, drawn);
+                let weight = drawn.map_or(1.0, |(p, from)| mis(p, g.light_pdf(from, x, h.prim)));
+                let contribution = beta * radiance * weight;
+                hooks.emission(contribution);
+                return total + contribution;
+            }
+            Surface::Absorber => {
+                hooks.opaque(g, rng, &leg, x, k, drawn);
+                return total;
+            }
+            Surface::Transparent => {
+                let next = g.crossed(medium, k);
+                hooks.interface(g, rng, &leg, x, next);
+                medium = next;
+            }
+            Surface::Reflector { albedo } => {
+                let lobe = reflector_lobe(g, h.prim, x, w, albedo);
+                beta *= lobe.weight();
+                let v = Vertex {
+                    x,
+                    medium,
+                    skip,
+                    lobe,
+                    w_in: w,
+                    frame: Frame::Surface(k),
+                    beta,
+                    at_sensor: false,
+                };
+                hooks.reflect(g, rng, &leg, &v, k);
+                if H::NEXT_EVENT {
+                    total += hooks.connect(g, rng, &v);
+                }
+                w = hooks.scatter(g, rng, &v);
+                hooks.reflected(g, rng, &v, w);
+                drawn = H::NEXT_EVENT.then(|| (lobe.pdf(w), x));
+                depth += 1;
+                if !survives(depth, &mut beta, rng) {
+                    return total;
+                }
+            }
+        }
+    }
+}
+
+/// The radiance leaving the surface of primitive `p` at its point `y`
+/// toward a viewer arriving along `w` (in `medium`): one path continued
+/// from that surface event. A corner's jump evaluates each side with it.
+pub fn surface_radiance<G: Geometry>(
+    g: &G,
+    rng: &mut PathRng,
+    y: G::V,
+    p: Prim,
+    w: G::V,
+    medium: MediumId,
+) -> f64 {
+    match g.surface(p) {
+        Surface::Emitter { radiance } => radiance,
+        Surface::Absorber | Surface::Transparent => 0.0,
+        Surface::Reflector { albedo } => {
+            let lobe = reflector_lobe(g, p, y, w, albedo);
+            let v = Vertex {
+                x: y,
+                medium,
+                skip: p,
+                lobe,
+                w_in: w,
+                frame: Frame::Surface(g.shape(p)),
+                beta: lobe.weight(),
+                at_sensor: false,
+            };
+            let direct = next_event(g, rng, &v);
+            let wo = lobe.sample(rng);
+            let drawn = Some((lobe.pdf(wo), y));
+            direct + walk(g, &mut (), rng, y, wo, medium, p, v.beta, drawn)
+        }
+    }
+}
+
+/// Whether `q` is visible from `x` (in `medium`, leaving `skip`): the
+/// transmittance to it and the medium there.
+pub fn reach<G: Geometry>(
+    g: &G,
+    mut x: G::V,
+    q: G::V,
+    mut medium: MediumId,
+    mut skip: Prim,
+) -> Option<(f64, MediumId)> {
+    let d = q - x;
+    let mut left = d.length();
+    let w = d * (1.0 / left);
+    let mut tau = 0.0;
+    loop {
+        let ke = g.coefficients(medium).map_or(0.0, |c| c.1);
+        match g.cast(x, w, skip) {
+            Some(h) if h.t < left * (1.0 - 1e-9) => {
+                if g.surface(h.prim) != Surface::Transparent {
+                    return None;
+                }
+                tau += ke * h.t;
+                left -= h.t;
+                x = x + w * h.t;
+                skip = h.prim;
+                medium = g.crossed(medium, g.shape(h.prim));
+            }
+            _ => return Some(((-(tau + ke * left)).exp(), medium)),
+        }
+    }
+}
+
+/// One-sample estimate of the radiance arriving at `x` from direction `w`
+/// (the path travels along `w`), `x` lying in `medium`, leaving `skip`.
+#[inline]
+pub fn radiance<G: Geometry>(
+    g: &G,
+    rng: &mut PathRng,
+    x: G::V,
+    w: G::V,
+    medium: MediumId,
+    skip: Prim,
+) -> f64 {
+    walk(g, &mut (), rng, x, w, medium, skip, 1.0, None)
+}
