@@ -7,11 +7,14 @@
 //! ROUNDS (default 5) one-thread runs of PATHS paths (default 200000).
 //!
 //! Two baselines: `intensity` (the intensity estimator, with next-event
-//! estimation; `cost/int`) and `plain`, the derivative walk on the scene
-//! stripped of its parameters: the same paths traced with no derivative and
-//! no next-event estimation (`cost/plain`).
+//! estimation; `cost/int`) and `plain`, plain path tracing without
+//! next-event estimation (`cost/plain`). Then σ²·t, the variance times the
+//! run's time, per parameter and derivative method, with its ratio to the
+//! best (finite differences left out: they are biased).
+use geosens::flat::space::Plane;
 use geosens::flat::{Method, Motion, Parameter, Scene, Sensor, Shape, Surface, file};
-use geosens::{RunConfig, run};
+use geosens::path::intensity::PlainEstimator;
+use geosens::{Quantity, RunConfig, RunResult, run};
 use glam::DVec2;
 use std::path::Path;
 use std::sync::Arc;
@@ -73,17 +76,21 @@ fn main() {
         "{:<14} {:>4} {:<12} {:>12} {:>9} {:>10}",
         "scene", "par", "method", "paths/s", "cost/int", "cost/plain"
     );
+    let mut efficiency = Vec::new();
     for (name, scene) in &scenes {
         let cfg = RunConfig::new(paths, 1).unwrap().threads(1);
+        // Median time of the rounds, and the run at that time.
         let median = |e: &dyn geosens::Estimator| {
-            let mut t: Vec<f64> = (0..rounds).map(|_| run(e, &cfg).unwrap().seconds).collect();
-            t.sort_by(f64::total_cmp);
-            t[t.len() / 2]
+            let mut runs: Vec<RunResult> = (0..rounds).map(|_| run(e, &cfg).unwrap()).collect();
+            runs.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
+            runs.swap_remove(runs.len() / 2)
         };
-        let bare =
-            Arc::new(Scene::new(scene.shapes().to_vec(), Vec::new(), scene.sensor()).unwrap());
-        let plain = median(Method::Expectation.estimator(bare).unwrap().as_ref());
-        let intensity = median(Method::Intensity.estimator(scene.clone()).unwrap().as_ref());
+        let plain = median(&PlainEstimator {
+            geometry: Plane::new(scene.clone()),
+        })
+        .seconds;
+        let intensity =
+            median(Method::Intensity.estimator(scene.clone()).unwrap().as_ref()).seconds;
         println!(
             "{:<14} {:>4} {:<12} {:>12.3e} {:>9.2} {:>10.2}",
             name,
@@ -94,7 +101,8 @@ fn main() {
             1.0
         );
         for m in methods {
-            let t = median(m.estimator(scene.clone()).unwrap().as_ref());
+            let r = median(m.estimator(scene.clone()).unwrap().as_ref());
+            let t = r.seconds;
             println!(
                 "{:<14} {:>4} {:<12} {:>12.3e} {:>9.2} {:>10.2}",
                 name,
@@ -104,6 +112,31 @@ fn main() {
                 t / intensity,
                 t / plain
             );
+            if m != Method::Intensity {
+                efficiency.push((name.clone(), m, r));
+            }
+        }
+    }
+    // σ²·t (variance times the run's time: the work-normalised variance) per
+    // parameter, and its ratio to the best method's.
+    println!("\nσ²·t per parameter (ratio to the best method)");
+    for (name, scene) in &scenes {
+        for p in scene.parameters() {
+            let q = Quantity::sensitivity(&p.name);
+            let cells: Vec<(Method, f64)> = efficiency
+                .iter()
+                .filter(|(n, m, _)| n == name && *m != Method::Fd)
+                .map(|(_, m, r)| {
+                    let e = r.get(&q).unwrap();
+                    (*m, e.stderr * e.stderr * r.seconds)
+                })
+                .collect();
+            let best = cells.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+            let row: Vec<String> = cells
+                .iter()
+                .map(|(m, v)| format!("{} {:.2e} ({:.1})", m.name(), v, v / best))
+                .collect();
+            println!("{:<14} {:<16} {}", name, p.name, row.join("  "));
         }
     }
 }

@@ -81,7 +81,12 @@ fn derivative_walks_connect_to_a_small_lamp() {
     // once in ~10⁴ directions.
     let scene = Scene::new(
         vec![
-            segment("lamp", [0.4995, 2.0], [0.5005, 2.0], Surface::Emitter { radiance: 1.0 }),
+            segment(
+                "lamp",
+                [0.4995, 2.0],
+                [0.5005, 2.0],
+                Surface::Emitter { radiance: 1.0 },
+            ),
             segment("occ", [-0.6, 1.0], [0.25, 1.0], Surface::Absorber),
         ],
         vec![
@@ -97,7 +102,11 @@ fn derivative_walks_connect_to_a_small_lamp() {
     // As well estimated as by the intensity estimator: the same connection.
     let intensity = sigma[0].1;
     for (m, s) in &sigma[1..] {
-        assert!(*s < 1.5 * intensity, "{}: σ(I) {s} vs {intensity}", m.name());
+        assert!(
+            *s < 1.5 * intensity,
+            "{}: σ(I) {s} vs {intensity}",
+            m.name()
+        );
     }
 }
 
@@ -107,7 +116,12 @@ fn derivative_walks_connect_to_a_grazing_lamp() {
     // hidden.
     let scene = Scene::new(
         vec![
-            segment("lamp", [0.5, 1.0], [1.0, 2.001], Surface::Emitter { radiance: 2.0 }),
+            segment(
+                "lamp",
+                [0.5, 1.0],
+                [1.0, 2.001],
+                Surface::Emitter { radiance: 2.0 },
+            ),
             segment("occ", [-0.2, 0.8], [0.39992, 0.8], Surface::Absorber),
         ],
         vec![
@@ -122,7 +136,11 @@ fn derivative_walks_connect_to_a_grazing_lamp() {
     let sigma = check_against_closed_form(Arc::new(scene), 200_000, 6);
     let intensity = sigma[0].1;
     for (m, s) in &sigma[1..] {
-        assert!(*s < 1.5 * intensity, "{}: σ(I) {s} vs {intensity}", m.name());
+        assert!(
+            *s < 1.5 * intensity,
+            "{}: σ(I) {s} vs {intensity}",
+            m.name()
+        );
     }
 }
 

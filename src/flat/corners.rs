@@ -68,6 +68,14 @@ impl CornerGrid {
         grid
     }
 
+    /// The box the grid covers.
+    pub fn bounds(&self) -> (DVec2, DVec2) {
+        (
+            self.origin,
+            self.origin + self.cell * DVec2::new(self.nx as f64, self.ny as f64),
+        )
+    }
+
     fn cell_of(&self, p: DVec2) -> usize {
         let ix = (((p.x - self.origin.x) / self.cell) as usize).min(self.nx - 1);
         let iy = (((p.y - self.origin.y) / self.cell) as usize).min(self.ny - 1);

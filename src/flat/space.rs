@@ -27,6 +27,14 @@ pub struct Plane {
     corner_segments: Vec<[u32; 2]>,
     /// Indices of the corners of moving shapes.
     moving_corners: Vec<u32>,
+    /// Per corner, the weight with which rendering's boundary term draws
+    /// it: 1 at a polyline's end, `θ/π` at a corner turning by `θ` (the
+    /// share of viewpoints from which it is a silhouette; two collinear
+    /// faces of one surface have no jump at all).
+    corner_weight: Vec<f64>,
+    /// Cumulative weights over all corners, and over the moving ones.
+    all_cdf: Vec<f64>,
+    moving_cdf: Vec<f64>,
     /// The corners visible from an irradiance sensor in front of it, by
     /// angle from +x: the warp's knots there, the same for every path.
     sensor_knots: Vec<Knot>,
@@ -60,7 +68,7 @@ impl Plane {
         }
         let params = scene.parameters().len();
         let moving = |k: u32| (0..params).any(|j| scene.parameter_shape(j) == k);
-        let moving_corners = scene
+        let moving_corners: Vec<u32> = scene
             .corners()
             .iter()
             .enumerate()
@@ -78,10 +86,35 @@ impl Plane {
             FlatSensor::Radiance { .. } => Vec::new(),
         };
         sensor_knots.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let segments = scene.segments();
+        let corner_weight: Vec<f64> = corner_segments
+            .iter()
+            .map(|&[starts, ends]| {
+                if starts == NO_SEGMENT || ends == NO_SEGMENT {
+                    return 1.0;
+                }
+                let (a, b) = (segments[ends as usize], segments[starts as usize]);
+                let (da, db) = ((a.b - a.a).normalize(), (b.b - b.a).normalize());
+                cross(da, db).atan2(da.dot(db)).abs() / PI
+            })
+            .collect();
+        let cdf = |ids: &mut dyn Iterator<Item = usize>| {
+            let mut total = 0.0;
+            ids.map(|i| {
+                total += corner_weight[i];
+                total
+            })
+            .collect::<Vec<f64>>()
+        };
+        let all_cdf = cdf(&mut (0..corner_weight.len()));
+        let moving_cdf = cdf(&mut moving_corners.iter().map(|&i| i as usize));
         Plane {
             scene,
             corner_segments,
             moving_corners,
+            corner_weight,
+            all_cdf,
+            moving_cdf,
             sensor_knots,
         }
     }
@@ -329,28 +362,26 @@ pub struct FlatWarp {
 
 impl Boundaries for Plane {
     #[inline]
+    /// A corner drawn with probability proportional to its weight (a binary
+    /// search in the cumulative weights).
     fn sample_boundary(&self, _x: DVec2, all: bool, u: f64) -> Option<BoundaryPoint<DVec2>> {
-        let corners = self.scene.corners();
-        let count = if all {
-            corners.len()
-        } else {
-            self.moving_corners.len()
-        };
-        if count == 0 {
+        let cdf = if all { &self.all_cdf } else { &self.moving_cdf };
+        let total = *cdf.last()?;
+        if total <= 0.0 {
             return None;
         }
-        let pick = ((u * count as f64) as usize).min(count - 1);
+        let pick = cdf.partition_point(|&c| c <= u * total).min(cdf.len() - 1);
         let index = if all {
             pick as u32
         } else {
             self.moving_corners[pick]
         };
-        let (q, shape) = corners[index as usize];
+        let (q, shape) = self.scene.corners()[index as usize];
         Some(BoundaryPoint {
             q,
             shape,
             index,
-            inv_pdf: count as f64,
+            inv_pdf: total / self.corner_weight[index as usize],
         })
     }
 
@@ -452,8 +483,6 @@ impl Plane {
         w: DVec2,
         (h_ccw, h_cw): (f64, f64),
     ) -> (Option<Knot>, Option<Knot>) {
-        let scene = &*self.scene;
-        let corners = scene.corners();
         let limit = |h: f64| {
             if h >= TAU {
                 4.0
@@ -466,6 +495,21 @@ impl Plane {
         if let Some(knots) = self.knots_in_triangles(x, skip, w, lim_ccw, lim_cw) {
             return knots;
         }
+        self.scan_knots(x, skip, w, lim_ccw, lim_cw)
+    }
+
+    /// [`Self::nearest_knots`] by a scan of every corner (pseudo-angle
+    /// limits).
+    fn scan_knots(
+        &self,
+        x: DVec2,
+        skip: u32,
+        w: DVec2,
+        lim_ccw: f64,
+        lim_cw: f64,
+    ) -> (Option<Knot>, Option<Knot>) {
+        let scene = &*self.scene;
+        let corners = scene.corners();
         let (mut bound_ccw, mut bound_cw) = (0.0, 0.0);
         let (mut done_ccw, mut done_cw) = (false, false);
         let (mut ccw, mut cw) = (None, None);
@@ -524,7 +568,9 @@ impl Plane {
     ) -> Option<(Option<Knot>, Option<Knot>)> {
         let scene = &*self.scene;
         let grid = scene.corner_grid()?;
-        let (t, seg, k_hit) = scene.opaque_hit(x, w, skip)?;
+        let Some((t, seg, k_hit)) = scene.opaque_hit(x, w, skip) else {
+            return Some(self.knots_escaping(grid, x, w, lim_ccw, lim_cw));
+        };
         let p = x + t * w;
         let (sa, sb) = (cross(w, seg.a - x), cross(w, seg.b - x));
         let (e_ccw, e_cw) = if sa > 0.0 && sb < 0.0 {
@@ -556,6 +602,82 @@ impl Plane {
             best.map(|(_, q, k)| knot(x, w, (q, k), ccw))
         };
         Some((side(e_ccw, lim_ccw, true), side(e_cw, lim_cw, false)))
+    }
+
+    /// The nearest visible corners on either side of a direction that hits
+    /// nothing opaque: the same triangle argument with the edges of a box
+    /// around the scene (and `x`) in the place of the hit segment. The ray
+    /// leaves the box at `p` on an edge no segment crosses; if no corner
+    /// lies inside the triangle (`x`, `p`, the edge's end `e`), no segment
+    /// enters it (it could cross only `x e`, and at most once), so the sight
+    /// line to `e` is clear and the search goes on in (`x`, `e`, next box
+    /// corner), around the box up to the lobe's horizon.
+    fn knots_escaping(
+        &self,
+        grid: &super::corners::CornerGrid,
+        x: DVec2,
+        w: DVec2,
+        lim_ccw: f64,
+        lim_cw: f64,
+    ) -> (Option<Knot>, Option<Knot>) {
+        let (lo, hi) = grid.bounds();
+        let margin = 0.01 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        let (lo, hi) = (lo.min(x) - margin, hi.max(x) + margin);
+        // Box corners counter-clockwise; the exit edge i runs box[i] → box[i+1].
+        let boxc = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+        let mut exit = (f64::INFINITY, 0usize);
+        for i in 0..4 {
+            let (a, b) = (boxc[i], boxc[(i + 1) % 4]);
+            let e = b - a;
+            let denom = cross(w, e);
+            if denom == 0.0 {
+                continue;
+            }
+            let t = cross(a - x, e) / denom;
+            let s = cross(a - x, w) / denom;
+            if t > 0.0 && (0.0..=1.0).contains(&s) && t < exit.0 {
+                exit = (t, i);
+            }
+        }
+        let p = x + exit.0 * w;
+        let corners = self.scene.corners();
+        let side = |lim: f64, ccw: bool| -> Option<Knot> {
+            let angle = |q: DVec2| {
+                let r = q - x;
+                let pa = pseudo_angle(w.dot(r), cross(w, r));
+                if ccw { pa } else { 4.0 - pa }
+            };
+            let mut from = p;
+            // Around the box and back to p: five triangles cover the circle.
+            for step in 0..5 {
+                let i = exit.1;
+                let e = match (step, ccw) {
+                    (4, _) => p,
+                    (_, true) => boxc[(i + 1 + step) % 4],
+                    (_, false) => boxc[(i + 4 - step) % 4],
+                };
+                let mut best: Option<(f64, DVec2, u32)> = None;
+                grid.near_triangle(x, from, e, |c| {
+                    let (q, k) = corners[c as usize];
+                    let pq = angle(q);
+                    if pq < lim
+                        && best.is_none_or(|b| pq < b.0)
+                        && super::corners::inside(x, from, e, q)
+                    {
+                        best = Some((pq, q, k));
+                    }
+                });
+                if let Some((_, q, k)) = best {
+                    return Some(knot(x, w, (q, k), ccw));
+                }
+                if angle(e) >= lim {
+                    return None;
+                }
+                from = e;
+            }
+            None
+        };
+        (side(lim_ccw, true), side(lim_cw, false))
     }
 
     /// The neighbours of `w` among the sensor's knots (precomputed: the
@@ -645,4 +767,84 @@ pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
             wd.dot(perp(w))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flat::scene::{Shape, Surface};
+    use rand::SeedableRng;
+
+    /// A reflecting vault open at the bottom (rays escape there) over an
+    /// occluder and a lamp, with enough corners for the grid.
+    fn vault() -> Plane {
+        let arc = |n: usize, r0: f64| -> Vec<DVec2> {
+            (0..=n)
+                .map(|i| {
+                    let a = 0.1 + (PI - 0.2) * i as f64 / n as f64;
+                    let r = r0 + 0.05 * (40.0 * a).sin();
+                    DVec2::new(r * a.cos(), r * a.sin())
+                })
+                .collect()
+        };
+        let shape = |name: &str, vertices: Vec<DVec2>, surface| Shape {
+            name: name.into(),
+            vertices,
+            closed: false,
+            surface,
+            medium: None,
+        };
+        let scene = Scene::new(
+            vec![
+                shape("vault", arc(500, 3.0), Surface::Reflector { albedo: 0.5 }),
+                shape(
+                    "lamp",
+                    vec![DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0)],
+                    Surface::Emitter { radiance: 1.0 },
+                ),
+                shape(
+                    "occ",
+                    vec![DVec2::new(-0.6, 1.0), DVec2::new(0.2, 1.0)],
+                    Surface::Absorber,
+                ),
+            ],
+            vec![],
+            FlatSensor::Irradiance {
+                point: DVec2::ZERO,
+                normal: DVec2::Y,
+            },
+        )
+        .unwrap();
+        Plane::new(Arc::new(scene))
+    }
+
+    #[test]
+    fn the_grid_finds_the_knots_the_scan_finds() {
+        let plane = vault();
+        assert!(plane.scene.corner_grid().is_some());
+        let mut rng = crate::rng::PathRng::seed_from_u64(9);
+        let (mut escaping, mut hitting) = (0, 0);
+        for _ in 0..4000 {
+            let x = DVec2::new(
+                rng.random::<f64>() * 5.0 - 2.5,
+                rng.random::<f64>() * 2.6 - 0.3,
+            );
+            let w = super::super::geometry::direction(rng.random::<f64>() * TAU);
+            let limits = [(4.0, 4.0), (2.0, 2.0), (1.5, 0.7)];
+            let (lim_ccw, lim_cw) = limits[rng.random_range(0..3)];
+            let Some(grid) = plane.knots_in_triangles(x, NO_SEGMENT, w, lim_ccw, lim_cw) else {
+                continue;
+            };
+            if plane.scene.opaque_hit(x, w, NO_SEGMENT).is_some() {
+                hitting += 1;
+            } else {
+                escaping += 1;
+            }
+            let scan = plane.scan_knots(x, NO_SEGMENT, w, lim_ccw, lim_cw);
+            let key = |k: Option<Knot>| k.map(|k| (k.1.x, k.1.y));
+            assert_eq!(key(grid.0), key(scan.0), "ccw at {x} along {w}");
+            assert_eq!(key(grid.1), key(scan.1), "cw at {x} along {w}");
+        }
+        assert!(escaping > 300 && hitting > 300, "{escaping} {hitting}");
+    }
 }

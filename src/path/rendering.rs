@@ -190,8 +190,12 @@ pub(super) fn corner_jump<G: Boundaries>(
         Side::Surface(p) => surface_radiance(g, rng, b.q, p, wq, medium),
         Side::Past => radiance(g, rng, b.q, wq, medium, NO_PRIM),
     };
+    // Common random numbers for the two sides: where both see a surface
+    // (a reflector's corner between two faces) their difference is small
+    // and so is its variance.
+    let mut twin = rng.clone();
     let l_ahead = side(rng, ahead);
-    let l_behind = side(rng, behind);
+    let l_behind = side(&mut twin, behind);
     // d/dπ ∫ f L dω ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
     let term = v.beta * f * t * (l_behind - l_ahead) * b.inv_pdf;
     for j in involved.iter() {
