@@ -25,6 +25,10 @@
 //! with closed-form and quadrature references ([`flat::exact`]) and scene
 //! files ([`flat::file`]). The book (`book/`) derives every estimator.
 //!
+//! The figures (`plot`, `rod::figures`, `flat::figures`) are behind the
+//! default cargo feature `figures`, which brings in plotters and its system
+//! font libraries; `default-features = false` leaves them out.
+//!
 //! ```
 //! use geosens::rod::{Direction, Probe, Rod, Method};
 //! use geosens::{run, Quantity, RunConfig};
@@ -46,6 +50,7 @@ pub mod estimator;
 pub mod fd;
 pub mod flat;
 pub mod path;
+#[cfg(feature = "figures")]
 pub mod plot;
 pub mod rng;
 pub mod rod;

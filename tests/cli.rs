@@ -310,6 +310,7 @@ fn compare_runs() {
 }
 
 #[test]
+#[cfg(feature = "figures")]
 fn compare_writes_the_figures() {
     let dir = std::env::temp_dir().join(format!("geosens-cli-figures-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -350,4 +351,25 @@ fn compare_writes_the_figures() {
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+#[cfg(not(feature = "figures"))]
+fn compare_without_the_figures_feature_says_so() {
+    let dir = std::env::temp_dir().join(format!("geosens-cli-no-figures-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = geosens(&[
+        "compare",
+        "--paths",
+        "1000",
+        "--threads",
+        "2",
+        "--figures",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("thick rod"));
+    assert!(stderr.contains("`figures` feature"), "{stderr}");
+    assert!(!dir.exists(), "{} written", dir.display());
 }

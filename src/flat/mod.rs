@@ -4,6 +4,7 @@
 pub mod bvh;
 pub mod corners;
 pub mod exact;
+#[cfg(feature = "figures")]
 pub mod figures;
 pub mod file;
 pub mod geometry;

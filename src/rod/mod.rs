@@ -14,6 +14,7 @@ use crate::estimator::Estimator;
 
 pub mod exact;
 pub mod expectation;
+#[cfg(feature = "figures")]
 pub mod figures;
 pub mod intensity;
 pub mod rendering;
