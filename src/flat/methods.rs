@@ -163,5 +163,5 @@ impl Estimator for FiniteDifference {
 /// for every parameter. For an irradiance sensor, directions behind it get
 /// 0 (the field is pinned to the frame at the horizons).
 pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
-    super::space::sensor_warp(plane, phi)
+    super::boundaries::sensor_warp(plane, phi)
 }

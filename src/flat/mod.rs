@@ -1,6 +1,7 @@
 //! Flatland: polygon scenes in the plane whose shapes translate, rotate and
 //! scale, with the rod's estimator interface. The book's chapter "Flatland"
 //! derives every estimator.
+pub mod boundaries;
 pub mod bvh;
 pub mod corners;
 pub mod exact;
@@ -8,6 +9,7 @@ pub mod exact;
 pub mod figures;
 pub mod file;
 pub mod geometry;
+pub mod lobe;
 pub mod methods;
 pub mod scene;
 pub mod space;

@@ -17,7 +17,8 @@
 use super::{FigureOptions, load, save};
 use crate::error::Error;
 use crate::flat::geometry::{NO_SEGMENT, perp};
-use crate::flat::space::{Plane, cosine_direction};
+use crate::flat::lobe::cosine_direction;
+use crate::flat::space::Plane;
 use crate::flat::{Scene, Sensor, Surface};
 use crate::path::intensity::radiance_observed;
 use crate::plot::{Figure, Panel, Series};

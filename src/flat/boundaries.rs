@@ -1,0 +1,523 @@
+//! Flatland's discontinuities behind the path core's [`Boundaries`]: the
+//! corners of opaque shapes (drawn by weight for rendering's and
+//! transport's jumps, with what either side of a corner sees) and the
+//! expectation method's warp, piecewise linear on the circle between the
+//! nearest visible corners (by the corner grid, or a scan for few corners).
+//! Book: chapter "Flatland: one deformation, three estimators", sections
+//! "Corner jumps" and "The warp field".
+use super::geometry::{NO_SEGMENT, cross, perp};
+use super::lobe::FlatLobe;
+use super::scene::{Phase, Sensor as FlatSensor};
+use super::space::{Knot, Plane};
+use crate::path::walk::Vertex;
+use crate::path::{Boundaries, BoundaryPoint, NO_PRIM, Side};
+use glam::DVec2;
+use std::f64::consts::TAU;
+
+/// A monotone stand-in for the counter-clockwise angle in `[0, 4)` of a
+/// vector with cosine part `c` and sine part `s` relative to a direction.
+#[inline]
+fn pseudo_angle(c: f64, s: f64) -> f64 {
+    let t = c / (c.abs() + s.abs());
+    if s >= 0.0 { 1.0 - t } else { 3.0 + t }
+}
+
+/// The warp at a vertex for a sampled direction: the nearest visible corner
+/// (or the lobe's horizon) on each side.
+#[derive(Debug, Clone, Copy)]
+pub struct FlatWarp {
+    ccw: Option<Knot>,
+    cw: Option<Knot>,
+    horizons: (f64, f64),
+}
+
+impl Boundaries for Plane {
+    #[inline]
+    /// A corner drawn with probability proportional to its weight (a binary
+    /// search in the cumulative weights).
+    fn sample_boundary(&self, _x: DVec2, all: bool, u: f64) -> Option<BoundaryPoint<DVec2>> {
+        let cdf = if all { &self.all_cdf } else { &self.moving_cdf };
+        let total = *cdf.last()?;
+        if total <= 0.0 {
+            return None;
+        }
+        let pick = cdf.partition_point(|&c| c <= u * total).min(cdf.len() - 1);
+        let index = if all {
+            pick as u32
+        } else {
+            self.moving_corners[pick]
+        };
+        let (q, shape) = self.scene.corners()[index as usize];
+        Some(BoundaryPoint {
+            q,
+            shape,
+            index,
+            inv_pdf: total / self.corner_weight[index as usize],
+        })
+    }
+
+    /// The segments at the corner that lie on either side of the sight line
+    /// `ω` from `x`; on each side the ray just past the line meets the one
+    /// whose direction `d` from the corner has the least `(d·ω)/|ω × d|`
+    /// (it is crossed first), or none.
+    fn sides(&self, x: DVec2, b: &BoundaryPoint<DVec2>) -> (Side, Side) {
+        let w = (b.q - x).normalize();
+        let segments = self.scene.segments();
+        let (mut ccw, mut cw) = ((f64::INFINITY, Side::Past), (f64::INFINITY, Side::Past));
+        for s in self.corner_segments[b.index as usize] {
+            if s == NO_SEGMENT {
+                continue;
+            }
+            let seg = segments[s as usize];
+            let other = if (seg.a - b.q).length_squared() < (seg.b - b.q).length_squared() {
+                seg.b
+            } else {
+                seg.a
+            };
+            let d = other - b.q;
+            let c = cross(w, d);
+            if c == 0.0 {
+                continue; // along the sight line: a grazing ray sees none of it
+            }
+            let order = d.dot(w) / c.abs();
+            let side = if c > 0.0 { &mut ccw } else { &mut cw };
+            if order < side.0 {
+                *side = (order, Side::Surface(s));
+            }
+        }
+        (ccw.1, cw.1)
+    }
+
+    #[inline]
+    fn boundary_normal(&self, x: DVec2, b: &BoundaryPoint<DVec2>) -> DVec2 {
+        perp((b.q - x).normalize())
+    }
+
+    type Warp = FlatWarp;
+
+    fn warp(&self, v: &Vertex<Self>, w: DVec2) -> FlatWarp {
+        let horizons = v.lobe.horizons(w);
+        let (ccw, cw) = if v.at_sensor {
+            self.sensor_knots(w, horizons)
+        } else {
+            self.nearest_knots(v.x, v.skip, w, horizons)
+        };
+        FlatWarp { ccw, cw, horizons }
+    }
+
+    #[inline]
+    fn warp_shapes(&self, warp: &FlatWarp, mut f: impl FnMut(u32)) {
+        for k in [warp.ccw, warp.cw].into_iter().flatten() {
+            f(k.2);
+        }
+    }
+
+    #[inline]
+    fn warp_velocity(
+        &self,
+        warp: &FlatWarp,
+        x: DVec2,
+        w: DVec2,
+        u: DVec2,
+        spin: f64,
+        velocity: impl Fn(DVec2, u32) -> DVec2,
+    ) -> (DVec2, f64) {
+        // Knot values: a corner's angular velocity, or the frame's at a
+        // horizon (which keeps the integrand's domain in place).
+        let rate = |q: DVec2, k: u32| {
+            let r = q - x;
+            cross(r, velocity(q, k) - u) / r.length_squared()
+        };
+        let (db, vb) = match warp.ccw {
+            Some((delta, q, k)) => (delta, rate(q, k)),
+            None => (warp.horizons.0, spin),
+        };
+        let (da, va) = match warp.cw {
+            Some((delta, q, k)) => (delta, rate(q, k)),
+            None => (warp.horizons.1, spin),
+        };
+        let slope = (vb - va) / (da + db);
+        (perp(w) * (va + slope * da), slope)
+    }
+}
+
+impl Plane {
+    /// The visible corners nearest to `w` counter-clockwise and clockwise,
+    /// closer than the lobe's horizons `(h_ccw, h_cw)` radians: `(angle,
+    /// corner, shape)` each. One pass orders the corners by a pseudo-angle
+    /// (monotone in the angle, no trigonometry); only the winners get a
+    /// shadow ray, and a hidden winner makes its side scan again past it.
+    fn nearest_knots(
+        &self,
+        x: DVec2,
+        skip: u32,
+        w: DVec2,
+        (h_ccw, h_cw): (f64, f64),
+    ) -> (Option<Knot>, Option<Knot>) {
+        let limit = |h: f64| {
+            if h >= TAU {
+                4.0
+            } else {
+                let (s, c) = h.sin_cos();
+                pseudo_angle(c, s)
+            }
+        };
+        let (lim_ccw, lim_cw) = (limit(h_ccw), limit(h_cw));
+        if let Some(knots) = self.knots_in_triangles(x, skip, w, lim_ccw, lim_cw) {
+            return knots;
+        }
+        self.scan_knots(x, skip, w, lim_ccw, lim_cw)
+    }
+
+    /// [`Self::nearest_knots`] by a scan of every corner (pseudo-angle
+    /// limits).
+    fn scan_knots(
+        &self,
+        x: DVec2,
+        skip: u32,
+        w: DVec2,
+        lim_ccw: f64,
+        lim_cw: f64,
+    ) -> (Option<Knot>, Option<Knot>) {
+        let scene = &*self.scene;
+        let corners = scene.corners();
+        let (mut bound_ccw, mut bound_cw) = (0.0, 0.0);
+        let (mut done_ccw, mut done_cw) = (false, false);
+        let (mut ccw, mut cw) = (None, None);
+        while !(done_ccw && done_cw) {
+            let (mut best_ccw, mut best_cw) = (lim_ccw, lim_cw);
+            let (mut i_ccw, mut i_cw) = (usize::MAX, usize::MAX);
+            for (i, &(q, _)) in corners.iter().enumerate() {
+                let r = q - x;
+                let p = pseudo_angle(w.dot(r), cross(w, r));
+                if !done_ccw && p > bound_ccw && p < best_ccw {
+                    best_ccw = p;
+                    i_ccw = i;
+                }
+                let pc = 4.0 - p;
+                if !done_cw && pc > bound_cw && pc < best_cw {
+                    best_cw = pc;
+                    i_cw = i;
+                }
+            }
+            // A side is settled when its nearest candidate is visible or it
+            // has none; a hidden one moves that side's bound past it.
+            let settle = |done: &mut bool, i: usize, best: f64, bound: &mut f64| {
+                if *done {
+                    return None;
+                }
+                if i == usize::MAX {
+                    *done = true;
+                    None
+                } else if scene.visible(x, corners[i].0, skip) {
+                    *done = true;
+                    Some(i)
+                } else {
+                    *bound = best;
+                    None
+                }
+            };
+            ccw = ccw.or(settle(&mut done_ccw, i_ccw, best_ccw, &mut bound_ccw));
+            cw = cw.or(settle(&mut done_cw, i_cw, best_cw, &mut bound_cw));
+        }
+        let knot = |i: Option<usize>, ccw: bool| i.map(|i| knot(x, w, corners[i], ccw));
+        (knot(ccw, true), knot(cw, false))
+    }
+
+    /// [`Self::nearest_knots`] through the corner grid: the nearest visible
+    /// corner on each side is the hit segment's end there or the
+    /// smallest-angle corner inside the triangle (vertex, hit point, end);
+    /// the module `corners` proves it. `None` (use the scan) without a grid
+    /// or when the direction hits nothing opaque.
+    fn knots_in_triangles(
+        &self,
+        x: DVec2,
+        skip: u32,
+        w: DVec2,
+        lim_ccw: f64,
+        lim_cw: f64,
+    ) -> Option<(Option<Knot>, Option<Knot>)> {
+        let scene = &*self.scene;
+        let grid = scene.corner_grid()?;
+        let Some((t, seg, k_hit)) = scene.opaque_hit(x, w, skip) else {
+            return Some(self.knots_escaping(grid, x, w, lim_ccw, lim_cw));
+        };
+        let p = x + t * w;
+        let (sa, sb) = (cross(w, seg.a - x), cross(w, seg.b - x));
+        let (e_ccw, e_cw) = if sa > 0.0 && sb < 0.0 {
+            (seg.a, seg.b)
+        } else if sb > 0.0 && sa < 0.0 {
+            (seg.b, seg.a)
+        } else {
+            return None; // the ray grazes an end: let the scan decide
+        };
+        let corners = scene.corners();
+        let side = |e: DVec2, lim: f64, ccw: bool| -> Option<Knot> {
+            let angle = |q: DVec2| {
+                let r = q - x;
+                let pa = pseudo_angle(w.dot(r), cross(w, r));
+                if ccw { pa } else { 4.0 - pa }
+            };
+            let mut best: Option<(f64, DVec2, u32)> = None;
+            let pe = angle(e);
+            if pe < lim {
+                best = Some((pe, e, k_hit));
+            }
+            grid.near_triangle(x, p, e, |i| {
+                let (q, k) = corners[i as usize];
+                let pq = angle(q);
+                if pq < lim && best.is_none_or(|b| pq < b.0) && super::corners::inside(x, p, e, q) {
+                    best = Some((pq, q, k));
+                }
+            });
+            best.map(|(_, q, k)| knot(x, w, (q, k), ccw))
+        };
+        Some((side(e_ccw, lim_ccw, true), side(e_cw, lim_cw, false)))
+    }
+
+    /// The nearest visible corners on either side of a direction that hits
+    /// nothing opaque: the same triangle argument with the edges of a box
+    /// around the scene (and `x`) in the place of the hit segment. The ray
+    /// leaves the box at `p` on an edge no segment crosses; if no corner
+    /// lies inside the triangle (`x`, `p`, the edge's end `e`), no segment
+    /// enters it (it could cross only `x e`, and at most once), so the sight
+    /// line to `e` is clear and the search goes on in (`x`, `e`, next box
+    /// corner), around the box up to the lobe's horizon.
+    fn knots_escaping(
+        &self,
+        grid: &super::corners::CornerGrid,
+        x: DVec2,
+        w: DVec2,
+        lim_ccw: f64,
+        lim_cw: f64,
+    ) -> (Option<Knot>, Option<Knot>) {
+        let (lo, hi) = grid.bounds();
+        let margin = 0.01 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
+        let (lo, hi) = (lo.min(x) - margin, hi.max(x) + margin);
+        // Box corners counter-clockwise; the exit edge i runs box[i] → box[i+1].
+        let boxc = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+        let mut exit = (f64::INFINITY, 0usize);
+        for i in 0..4 {
+            let (a, b) = (boxc[i], boxc[(i + 1) % 4]);
+            let e = b - a;
+            let denom = cross(w, e);
+            if denom == 0.0 {
+                continue;
+            }
+            let t = cross(a - x, e) / denom;
+            let s = cross(a - x, w) / denom;
+            if t > 0.0 && (0.0..=1.0).contains(&s) && t < exit.0 {
+                exit = (t, i);
+            }
+        }
+        let p = x + exit.0 * w;
+        let corners = self.scene.corners();
+        let side = |lim: f64, ccw: bool| -> Option<Knot> {
+            let angle = |q: DVec2| {
+                let r = q - x;
+                let pa = pseudo_angle(w.dot(r), cross(w, r));
+                if ccw { pa } else { 4.0 - pa }
+            };
+            let mut from = p;
+            // Around the box and back to p: five triangles cover the circle.
+            for step in 0..5 {
+                let i = exit.1;
+                let e = match (step, ccw) {
+                    (4, _) => p,
+                    (_, true) => boxc[(i + 1 + step) % 4],
+                    (_, false) => boxc[(i + 4 - step) % 4],
+                };
+                let mut best: Option<(f64, DVec2, u32)> = None;
+                grid.near_triangle(x, from, e, |c| {
+                    let (q, k) = corners[c as usize];
+                    let pq = angle(q);
+                    if pq < lim
+                        && best.is_none_or(|b| pq < b.0)
+                        && super::corners::inside(x, from, e, q)
+                    {
+                        best = Some((pq, q, k));
+                    }
+                });
+                if let Some((_, q, k)) = best {
+                    return Some(knot(x, w, (q, k), ccw));
+                }
+                if angle(e) >= lim {
+                    return None;
+                }
+                from = e;
+            }
+            None
+        };
+        (side(lim_ccw, true), side(lim_cw, false))
+    }
+
+    /// The neighbours of `w` among the sensor's knots (precomputed: the
+    /// sensor does not move).
+    fn sensor_knots(&self, w: DVec2, (h_ccw, h_cw): (f64, f64)) -> (Option<Knot>, Option<Knot>) {
+        let knots = &self.sensor_knots;
+        if knots.is_empty() {
+            return (None, None);
+        }
+        let phi = w.y.atan2(w.x);
+        let i = knots.partition_point(|k| k.0 <= phi);
+        let (b, b_angle) = if i < knots.len() {
+            (knots[i], knots[i].0 - phi)
+        } else {
+            (knots[0], knots[0].0 + TAU - phi)
+        };
+        let (a, a_angle) = if i > 0 {
+            (knots[i - 1], phi - knots[i - 1].0)
+        } else {
+            (knots[knots.len() - 1], phi - knots[knots.len() - 1].0 + TAU)
+        };
+        (
+            (b_angle < h_ccw).then_some((b_angle, b.1, b.2)),
+            (a_angle < h_cw && a_angle > 0.0).then_some((a_angle, a.1, a.2)),
+        )
+    }
+}
+
+/// The knot at corner `(q, k)` seen from `x`: its angle from `w`
+/// counter-clockwise (`ccw`) or clockwise, in `(0, 2π]`.
+#[inline]
+fn knot(x: DVec2, w: DVec2, (q, k): (DVec2, u32), ccw: bool) -> Knot {
+    let r = q - x;
+    let sign = if ccw { 1.0 } else { -1.0 };
+    let mut a = sign * cross(w, r).atan2(w.dot(r));
+    if a <= 0.0 {
+        a += TAU;
+    }
+    (a, q, k)
+}
+
+/// The warp field at the sensor for figures: `V_j(φ)` (rad per unit of
+/// parameter `j`) of the looking direction at angle `phi` from +x. For an
+/// irradiance sensor, directions behind it get 0 (the field is pinned to the
+/// frame at the horizons).
+pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
+    let scene = &plane.scene;
+    let n = scene.parameters().len();
+    let w = super::geometry::direction(phi);
+    let (x, lobe, at_sensor) = match scene.sensor() {
+        FlatSensor::Irradiance { point, normal } => {
+            if w.dot(normal) <= 0.0 {
+                return vec![0.0; n];
+            }
+            (point, FlatLobe::Cosine { n: normal, c: 1.0 }, true)
+        }
+        FlatSensor::Radiance { point, direction } => (
+            point,
+            FlatLobe::Phase {
+                phase: Phase::Isotropic,
+                w_in: direction,
+            },
+            false,
+        ),
+    };
+    let v = Vertex {
+        x,
+        medium: scene.sensor_medium(),
+        skip: NO_PRIM,
+        lobe,
+        w_in: w,
+        frame: crate::path::walk::Frame::Sensor,
+        beta: 1.0,
+        at_sensor,
+    };
+    let field = plane.warp(&v, w);
+    (0..n)
+        .map(|j| {
+            let velocity = |q: DVec2, k: u32| {
+                if scene.parameter_shape(j) == k {
+                    scene.parameters()[j].motion.velocity(q)
+                } else {
+                    DVec2::ZERO
+                }
+            };
+            let (wd, _) = plane.warp_velocity(&field, x, w, DVec2::ZERO, 0.0, velocity);
+            wd.dot(perp(w))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flat::scene::{Scene, Shape, Surface};
+    use rand::{RngExt, SeedableRng};
+    use std::f64::consts::PI;
+    use std::sync::Arc;
+
+    /// A reflecting vault open at the bottom (rays escape there) over an
+    /// occluder and a lamp, with enough corners for the grid.
+    fn vault() -> Plane {
+        let arc = |n: usize, r0: f64| -> Vec<DVec2> {
+            (0..=n)
+                .map(|i| {
+                    let a = 0.1 + (PI - 0.2) * i as f64 / n as f64;
+                    let r = r0 + 0.05 * (40.0 * a).sin();
+                    DVec2::new(r * a.cos(), r * a.sin())
+                })
+                .collect()
+        };
+        let shape = |name: &str, vertices: Vec<DVec2>, surface| Shape {
+            name: name.into(),
+            vertices,
+            closed: false,
+            surface,
+            medium: None,
+        };
+        let scene = Scene::new(
+            vec![
+                shape("vault", arc(500, 3.0), Surface::Reflector { albedo: 0.5 }),
+                shape(
+                    "lamp",
+                    vec![DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0)],
+                    Surface::Emitter { radiance: 1.0 },
+                ),
+                shape(
+                    "occ",
+                    vec![DVec2::new(-0.6, 1.0), DVec2::new(0.2, 1.0)],
+                    Surface::Absorber,
+                ),
+            ],
+            vec![],
+            FlatSensor::Irradiance {
+                point: DVec2::ZERO,
+                normal: DVec2::Y,
+            },
+        )
+        .unwrap();
+        Plane::new(Arc::new(scene))
+    }
+
+    #[test]
+    fn the_grid_finds_the_knots_the_scan_finds() {
+        let plane = vault();
+        assert!(plane.scene.corner_grid().is_some());
+        let mut rng = crate::rng::PathRng::seed_from_u64(9);
+        let (mut escaping, mut hitting) = (0, 0);
+        for _ in 0..4000 {
+            let x = DVec2::new(
+                rng.random::<f64>() * 5.0 - 2.5,
+                rng.random::<f64>() * 2.6 - 0.3,
+            );
+            let w = super::super::geometry::direction(rng.random::<f64>() * TAU);
+            let limits = [(4.0, 4.0), (2.0, 2.0), (1.5, 0.7)];
+            let (lim_ccw, lim_cw) = limits[rng.random_range(0..3)];
+            let Some(grid) = plane.knots_in_triangles(x, NO_SEGMENT, w, lim_ccw, lim_cw) else {
+                continue;
+            };
+            if plane.scene.opaque_hit(x, w, NO_SEGMENT).is_some() {
+                hitting += 1;
+            } else {
+                escaping += 1;
+            }
+            let scan = plane.scan_knots(x, NO_SEGMENT, w, lim_ccw, lim_cw);
+            let key = |k: Option<Knot>| k.map(|k| (k.1.x, k.1.y));
+            assert_eq!(key(grid.0), key(scan.0), "ccw at {x} along {w}");
+            assert_eq!(key(grid.1), key(scan.1), "cw at {x} along {w}");
+        }
+        assert!(escaping > 300 && hitting > 300, "{escaping} {hitting}");
+    }
+}
