@@ -161,3 +161,76 @@ fn corners_in_the_same_direction_give_the_closed_form() {
         );
     }
 }
+
+#[test]
+fn forty_parameters_on_one_path() {
+    // Twenty copies each of two motions of the occluder: every copy gets the
+    // closed form's derivative, from the same paths, with no cap in the way.
+    let mut parameters = Vec::new();
+    for i in 0..20 {
+        parameters.push(parameter(&format!("tx{i}"), "occ", Motion::TranslateX));
+        parameters.push(parameter(
+            &format!("rot{i}"),
+            "occ",
+            Motion::Rotate {
+                pivot: Some(DVec2::new(-0.2, 1.0)),
+            },
+        ));
+    }
+    let scene = Arc::new(
+        Scene::new(
+            vec![
+                segment(
+                    "lamp",
+                    [-1.0, 2.0],
+                    [1.0, 2.0],
+                    Surface::Emitter { radiance: 1.0 },
+                ),
+                segment("occ", [-0.6, 1.0], [0.2, 1.0], Surface::Absorber),
+            ],
+            parameters,
+            irradiance_up(),
+        )
+        .unwrap(),
+    );
+    let reference = Reference::for_scene(&scene).unwrap();
+    for method in [Method::Rendering, Method::Expectation, Method::Transport] {
+        let e = method.estimator(scene.clone()).unwrap();
+        let r = run(e.as_ref(), &RunConfig::new(50_000, 3).unwrap()).unwrap();
+        for (j, p) in scene.parameters().iter().enumerate() {
+            let s = r.get(&Quantity::sensitivity(&p.name)).unwrap();
+            let first = r.get(&Quantity::sensitivity(&scene.parameters()[j % 2].name));
+            assert_eq!(Some(s), first, "{} {}", method.name(), p.name);
+            let exact = reference.derivative(j);
+            assert!(
+                s.z_score(exact) < 4.0,
+                "{} {}: {s:?} vs {exact}",
+                method.name(),
+                p.name
+            );
+        }
+    }
+}
+
+#[test]
+fn too_many_parameters_is_a_clear_error() {
+    let parameters = (0..254)
+        .map(|i| parameter(&format!("p{i}"), "occ", Motion::TranslateX))
+        .collect();
+    let e = Scene::new(
+        vec![
+            segment(
+                "lamp",
+                [-1.0, 2.0],
+                [1.0, 2.0],
+                Surface::Emitter { radiance: 1.0 },
+            ),
+            segment("occ", [-0.6, 1.0], [0.2, 1.0], Surface::Absorber),
+        ],
+        parameters,
+        irradiance_up(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("254 parameters: at most 253"), "{e}");
+}

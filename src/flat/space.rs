@@ -81,6 +81,7 @@ impl Plane {
         };
         sensor_knots.sort_by(|a, b| a.0.total_cmp(&b.0));
         let segments = scene.segments();
+        // ANCHOR: corner_weight
         let corner_weight: Vec<f64> = corner_segments
             .iter()
             .map(|&[starts, ends]| {
@@ -92,6 +93,7 @@ impl Plane {
                 cross(da, db).atan2(da.dot(db)).abs() / PI
             })
             .collect();
+        // ANCHOR_END: corner_weight
         let cdf = |ids: &mut dyn Iterator<Item = usize>| {
             let mut total = 0.0;
             ids.map(|i| {

@@ -176,6 +176,7 @@ impl<V: Vector> Deform<V> {
         }
     }
 
+    // ANCHOR: boundary_speed
     /// `ṫ_b` for every slot in `live ∪ moving` at the hit `h` of the ray
     /// from `x` along `w`: the hit point stays on the boundary, whose
     /// material points move at `v_j` for the slots in `moving` (those that
@@ -209,6 +210,7 @@ impl<V: Vector> Deform<V> {
             }
         }
     }
+    // ANCHOR_END: boundary_speed
 
     /// Moves the vertex of every slot in `rule` onto the boundary at
     /// distance `t` along `w`: `u += ṫ_b ω + t ω̇`.
@@ -381,6 +383,7 @@ impl<G: Geometry> Hooks<G> for Follow<'_, G::V> {
     }
 }
 
+// ANCHOR: connect
 /// Next-event estimation at `v` for a derivative walk in state `d`: one
 /// emitter point drawn as the intensity estimator draws it; its direction
 /// `ω` deforms as `direction` sets it (the method's rule: the frame's turn,
@@ -419,3 +422,4 @@ pub fn connect<G: Geometry>(
     scratch.give(tmp);
     contribution
 }
+// ANCHOR_END: connect

@@ -31,6 +31,7 @@ pub struct Expectation<'a, G: Geometry> {
     pub d: Deform<G::V>,
 }
 
+// ANCHOR: warp
 /// Moves the direction `w` drawn at `v` with the warp: every slot's `ω̇`,
 /// and the warp's divergence plus `∂ ln f` along it added to its score.
 #[inline]
@@ -56,6 +57,7 @@ fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>
         d.touch(j);
     }
 }
+// ANCHOR_END: warp
 
 impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     #[inline]
@@ -68,6 +70,7 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
             None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
         }
     }
+    // ANCHOR: collision
     #[inline]
     fn collision(&mut self, w: G::V, xi: f64, t_b: f64, ke: f64) {
         // The free path stretches with its domain [0, t_b].
@@ -79,6 +82,7 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
             s.u = s.u + w * xi_dot + s.wd * xi;
         }
     }
+    // ANCHOR_END: collision
     #[inline]
     fn pass(&mut self, ke: f64) {
         self.d.pass(self.slots.all(), ke);

@@ -95,6 +95,7 @@ pub(super) fn attach<V: Vector>(d: &mut Deform<V>, rule: SlotSet, turning: SlotS
     }
 }
 
+// ANCHOR: leibniz
 /// The Leibniz term of the free-path domain ending at `t_b` on a moving
 /// boundary, for the slots in `rule`: `β κs e^{−κe t_b} L_s(t_b⁻) ṫ_b`.
 #[inline]
@@ -125,7 +126,9 @@ pub(super) fn leibniz<G: Geometry>(
         s.boundary += term * s.tb_dot;
     }
 }
+// ANCHOR_END: leibniz
 
+// ANCHOR: corner_jump
 /// The boundary term of the directional integral at `v`: one discontinuity
 /// drawn, the jump of the radiance across it evaluated exactly at it (one
 /// nested path for each side), times its velocity relative to the frame,
@@ -204,6 +207,7 @@ pub(super) fn corner_jump<G: Boundaries>(
         s.tb_dot = 0.0;
     }
 }
+// ANCHOR_END: corner_jump
 
 impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
     #[inline]

@@ -57,6 +57,7 @@ impl<G: Boundaries> Transport<'_, G> {
             .any(|j| self.d.slots[j].tb_dot != 0.0)
     }
 
+    // ANCHOR: surface_gradient
     /// The source `−v·∇L(y⁻, w)` where the leg hits the opaque moving
     /// boundary of shape `k` at `y`, for every shape-parameter slot: the
     /// gradient by a nested walk in the frozen scene started just before `y`.
@@ -82,6 +83,7 @@ impl<G: Boundaries> Transport<'_, G> {
         }
         self.scratch.give(nested);
     }
+    // ANCHOR_END: surface_gradient
 
     /// A walk in the frozen scene from `x` along `w` that differentiates
     /// the start velocities held in `nested`; returns its state. `drawn`:
@@ -158,6 +160,7 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             self.surface_gradient(g, rng, leg, y, k, drawn);
         }
     }
+    // ANCHOR: interface
     #[inline]
     fn interface(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, y: G::V, after: MediumId) {
         if !self.euler_moving() {
@@ -184,6 +187,7 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             }
         }
     }
+    // ANCHOR_END: interface
     #[inline]
     fn reflect(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, v: &Vertex<G>, k: u32) {
         let moving = self.slots.moving(k);

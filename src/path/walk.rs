@@ -64,6 +64,7 @@ pub struct Vertex<G: Geometry> {
     pub at_sensor: bool,
 }
 
+// ANCHOR: hooks
 /// What a method does at the loop's events. Every method is a default
 /// no-op, so the intensity estimator (`()`) pays nothing for them.
 #[allow(unused_variables)]
@@ -129,6 +130,7 @@ pub trait Hooks<G: Geometry> {
     #[inline]
     fn reflected(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>, w: G::V) {}
 }
+// ANCHOR_END: hooks
 
 impl<G: Geometry> Hooks<G> for () {}
 
@@ -228,6 +230,7 @@ pub fn next_event<G: Geometry>(g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
     c * transmittance(g, &mut (), v.x, w, v.medium, v.skip, p)
 }
 
+// ANCHOR: walk
 /// One path continued from `x` along `w` with throughput `beta` (`x` in
 /// `medium`, leaving `skip`), `drawn` the density with which the last
 /// scattering vertex drew `w` and that vertex (`None`: the direction was
@@ -343,6 +346,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
         }
     }
 }
+// ANCHOR_END: walk
 
 /// The radiance leaving the surface of primitive `p` at its point `y`
 /// toward a viewer arriving along `w` (in `medium`): one path continued

@@ -22,8 +22,9 @@ mod validate;
 /// medium is opaque for every purpose and the weights underflow.
 pub const MAX_OPTICAL_THICKNESS: f64 = 1e4;
 
-/// Most parameters (plus the two sensor-gradient axes) one path carries.
-pub const MAX_PARAMETERS: usize = 14;
+/// Most parameters one path carries (with room for the sensor gradient's
+/// axes in 3D): 253.
+pub const MAX_PARAMETERS: usize = crate::path::deform::MAX_SLOTS - 3;
 
 /// What happens to light arriving at a shape's boundary.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
