@@ -51,7 +51,7 @@ use obvhs::bvh2::builder::build_bvh2;
 use obvhs::faststack::{FastStack, StackStack};
 use obvhs::ray::{Ray, RayHit};
 
-use super::geometry::{Hit, NO_SEGMENT, RayCast, Segment, T_MIN};
+use super::geometry::{Hit, NO_SEGMENT, RayCast, Segment};
 
 /// Pad of every box and every distance bound, in units of the scene's
 /// half-size (the unit frame): 2⁻¹⁶ ≈ 1.5·10⁻⁵.
@@ -231,7 +231,7 @@ impl SegmentBvh {
     /// How to answer a query.
     #[inline]
     fn plan(&self, origin: DVec2, dir: DVec2, t_max: f64) -> Plan {
-        if t_max.is_nan() || t_max <= T_MIN || self.prims.is_empty() {
+        if t_max.is_nan() || t_max <= 0.0 || self.prims.is_empty() {
             return Plan::Miss;
         }
         let o = self.frame.map(origin);

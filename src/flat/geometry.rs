@@ -33,8 +33,10 @@ pub struct Segment {
 }
 
 impl Segment {
-    /// Distance `t > t_min` along the ray `origin + t dir` to the segment, if
-    /// the ray crosses it (ends included); `dir` need not be unit.
+    /// Distance `t` along the ray `origin + t dir` to the segment, if the ray
+    /// crosses it (ends included) farther than [`T_MIN`] times the segment's
+    /// length (a threshold that scales with the scene); `dir` need not be
+    /// unit.
     #[inline]
     pub fn intersect(&self, origin: DVec2, dir: DVec2) -> Option<f64> {
         let e = self.b - self.a;
@@ -45,7 +47,8 @@ impl Segment {
         let ao = self.a - origin;
         let t = cross(ao, e) / denom;
         let s = cross(ao, dir) / denom;
-        (t > T_MIN && (0.0..=1.0).contains(&s)).then_some(t)
+        let far = t > 0.0 && t * t * dir.length_squared() > T_MIN * T_MIN * e.length_squared();
+        (far && (0.0..=1.0).contains(&s)).then_some(t)
     }
 
     /// Length of the segment.
@@ -83,8 +86,10 @@ impl Segment {
     }
 }
 
-/// Smallest ray distance counted as a hit: a ray leaving a surface must not
-/// find the surface it leaves (the tracer also skips that segment by id).
+/// Smallest ray distance counted as a hit, relative to the length of the
+/// segment hit: a ray leaving a surface (or a corner) must not find the
+/// surface it leaves (the tracer also skips that segment by id). Relative,
+/// so a scene scaled by any factor validation accepts traces the same.
 pub const T_MIN: f64 = 1e-12;
 
 /// Twice the signed area of the triangle `a b c` (> 0 counter-clockwise).
@@ -136,10 +141,10 @@ pub const NO_SEGMENT: u32 = u32::MAX;
 
 /// Ray queries against a fixed list of segments.
 pub trait RayCast: Send + Sync {
-    /// The closest segment crossed by `origin + t dir` with `T_MIN < t < t_max`,
+    /// The closest segment crossed by `origin + t dir` with `T_MIN·length < t < t_max`,
     /// ignoring segment `skip` (the one the ray leaves, or [`NO_SEGMENT`]).
     fn closest_hit(&self, origin: DVec2, dir: DVec2, t_max: f64, skip: u32) -> Option<Hit>;
-    /// Whether any segment other than `skip` is crossed with `T_MIN < t < t_max`.
+    /// Whether any segment other than `skip` is crossed with `T_MIN·length < t < t_max`.
     fn any_hit(&self, origin: DVec2, dir: DVec2, t_max: f64, skip: u32) -> bool {
         self.closest_hit(origin, dir, t_max, skip).is_some()
     }

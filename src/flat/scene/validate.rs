@@ -78,9 +78,13 @@ fn finite(what: &str, p: DVec2) -> Result<(), Error> {
 
 fn unit(what: &str, v: DVec2) -> Result<DVec2, Error> {
     finite(what, v)?;
-    let n = v.length();
+    // Scaled first, so that no length overflows (a normal [1e308, 1e308]
+    // has a direction).
+    let m = v.abs().max_element();
+    let u = if m > 0.0 { v / m } else { v };
+    let n = u.length();
     if n > 0.0 && n.is_finite() {
-        Ok(v / n)
+        Ok(u / n)
     } else {
         config(format!("{what} = [{}, {}] has no direction", v.x, v.y))
     }
@@ -92,8 +96,11 @@ fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
     if shapes.is_empty() {
         return config("a scene needs at least one shape".into());
     }
+    // Names seen so far: a set, so 10⁵ shapes load in linear time.
+    let mut names = std::collections::HashSet::with_capacity(shapes.len());
     for (k, s) in shapes.iter().enumerate() {
-        check_shape(k, s, &shapes[..k])?;
+        let repeated = !names.insert(s.name.as_str());
+        check_shape(k, s, repeated)?;
     }
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
@@ -101,17 +108,31 @@ fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
         lo = lo.min(v);
         hi = hi.max(v);
     }
-    Ok((hi - lo).max_element().max(f64::MIN_POSITIVE))
+    let size = (hi - lo).max_element();
+    if !(MIN_SIZE..=MAX_SIZE).contains(&size) {
+        return config(format!(
+            "the scene's size (largest extent of its vertices' bounding box) is {size:e}: \
+             sizes from {MIN_SIZE:e} to {MAX_SIZE:e} are supported; rescale the scene \
+             (only κ × size and ratios of lengths matter)"
+        ));
+    }
+    Ok(size)
 }
 
-/// Checks shape `k` against the shapes before it (`earlier`): its name, its
+/// Smallest and largest scene size accepted: within them every squared
+/// length and cross product the tracer forms is a normal float.
+pub const MIN_SIZE: f64 = 1e-100;
+/// See [`MIN_SIZE`].
+pub const MAX_SIZE: f64 = 1e100;
+
+/// Checks shape `k`: its name (`repeated`: an earlier shape has it), its
 /// vertices, its surface and its medium.
-fn check_shape(k: usize, s: &Shape, earlier: &[Shape]) -> Result<(), Error> {
+fn check_shape(k: usize, s: &Shape, repeated: bool) -> Result<(), Error> {
     let name = &s.name;
     if name.is_empty() {
         return config(format!("shape {k} has an empty name"));
     }
-    if earlier.iter().any(|o| &o.name == name) {
+    if repeated {
         return config(format!("two shapes are named {name:?}"));
     }
     let least = if s.closed { 3 } else { 2 };
@@ -291,11 +312,12 @@ fn resolve_parameters(
             parameters.len()
         ));
     }
+    let mut names = std::collections::HashSet::with_capacity(parameters.len());
     for (j, p) in parameters.iter().enumerate() {
         if p.name.is_empty() {
             return config(format!("parameter {j} has an empty name"));
         }
-        if parameters[..j].iter().any(|o| o.name == p.name) {
+        if !names.insert(p.name.as_str()) {
             return config(format!("two parameters are named {:?}", p.name));
         }
         let Some(k) = shapes.iter().position(|s| s.name == p.shape) else {
