@@ -6,7 +6,7 @@
 //! higher path count (step 10⁻² of the scene size: its O(h²) bias is far
 //! under the bounds' standard errors wherever the derivative is smooth).
 use geosens::flat::exact::Reference;
-use geosens::flat::methods::FiniteDifference;
+use geosens::flat::methods::finite_difference;
 use geosens::flat::{Method, Scene, file};
 use geosens::{Estimate, Quantity, RunConfig, RunResult, run};
 use std::path::Path;
@@ -124,7 +124,7 @@ fn the_intensity_estimator_matches_the_closed_form() {
 /// differences with a 10× larger step at `fd_paths`.
 fn against_finite_differences(name: &str, paths: u64, fd_paths: u64) {
     let scene = scene(name);
-    let fd = FiniteDifference::new(scene.clone(), 1e-2).unwrap();
+    let fd = finite_difference(&scene, 1e-2).unwrap();
     let reference = run(&fd, &RunConfig::new(fd_paths, 99).unwrap()).unwrap();
     for (seed, method) in [Method::Rendering, Method::Expectation, Method::Transport]
         .into_iter()

@@ -7,69 +7,46 @@
 //!   the differentiated walk (module `walk`) with its three bookkeepings of
 //!   the path's deformation;
 //! - [`Method::Fd`]: central differences with common random numbers, one
-//!   pair of displaced scenes per parameter.
+//!   pair of displaced scenes per parameter ([`finite_difference`], built on
+//!   [`crate::fd`]).
 use super::geometry::NO_SEGMENT;
 use super::scene::{Scene, Sensor};
 use super::trace::{Lobe, cosine_direction, next_event, radiance, radiance_observed};
 use super::walk::{Scheme, Slots, Walk};
 use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
+use crate::fd::{CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement};
+use crate::method::Problem;
 use crate::rng::PathRng;
 use std::sync::Arc;
 
-/// A flatland estimation method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// Backward path tracing of `I` only.
-    Intensity,
-    /// Expectation differentiation: the warp field and stretched free paths;
-    /// `I` and every `∂I/∂π` from the same path.
-    Expectation,
-    /// Differentiable rendering: boundary terms at corners and medium
-    /// boundaries, joined by double randomisation.
-    Rendering,
-    /// Sensitivity transport: the path stays fixed in space; sources where
-    /// it meets moving boundaries, coupled to the radiance gradient there
-    /// (nested walks); also returns `∂I/∂x`, `∂I/∂y` at the sensor.
-    Transport,
-    /// Central finite differences with common random numbers (half step
-    /// [`FD_STEP`] × scene size for translations, [`FD_STEP`] for rotations
-    /// and scales).
-    Fd,
-}
+/// The methods: every [`Method`] runs on a flatland scene
+/// (`method.estimator(scene)` with `scene: Arc<Scene>`).
+pub use crate::method::Method;
 
-/// Half step of [`Method::Fd`], relative to the scene size (radians for a
-/// rotation, relative change for a scale).
-pub const FD_STEP: f64 = 1e-3;
-
-impl Method {
-    /// The method's name, as the CLI spells it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Intensity => "intensity",
-            Method::Expectation => "expectation",
-            Method::Rendering => "rendering",
-            Method::Transport => "transport",
-            Method::Fd => "fd",
-        }
-    }
-
-    /// The estimator of this method on `scene`.
-    pub fn estimator(self, scene: Arc<Scene>) -> Result<Box<dyn Estimator>, Error> {
-        Ok(match self {
+impl Problem for Arc<Scene> {
+    /// For [`Method::Fd`] the half step is `fd_step` times the scene's size
+    /// for a translation, `fd_step` radians for a rotation and `fd_step` for a
+    /// scale.
+    fn estimator(&self, method: Method, fd_step: Option<f64>) -> Result<Box<dyn Estimator>, Error> {
+        let scene = Arc::clone(self);
+        Ok(match method {
             Method::Intensity => Box::new(IntensityEstimator { scene }),
             Method::Expectation | Method::Rendering | Method::Transport => {
                 Box::new(DerivativeEstimator {
-                    slots: Slots::new(&scene, self == Method::Transport),
+                    slots: Slots::new(&scene, method == Method::Transport),
                     scene,
-                    scheme: match self {
+                    scheme: match method {
                         Method::Expectation => Scheme::Expectation,
                         Method::Rendering => Scheme::Rendering,
                         _ => Scheme::Transport,
                     },
                 })
             }
-            Method::Fd => Box::new(FiniteDifference::new(scene, FD_STEP)?),
+            Method::Fd => Box::new(finite_difference(
+                &scene,
+                fd_step.map_or(Ok(DEFAULT_STEP), check_step)?,
+            )?),
         })
     }
 }
@@ -161,49 +138,41 @@ impl Estimator for DerivativeEstimator {
     }
 }
 
-/// Central differences with common random numbers: per parameter `j`, the
-/// reading of the scene displaced by `±h_j` from copies of one generator
-/// state; `I` from the nominal scene with the same state.
-pub struct FiniteDifference {
-    scene: Arc<Scene>,
-    displaced: Vec<(Scene, Scene, f64)>,
-}
-
-impl FiniteDifference {
-    /// Half step `h` relative to the scene size for translations and
-    /// absolute for rotations (radians) and scales; errors if `h` is not
-    /// finite and positive or a displaced scene is invalid (shapes touching).
-    pub fn new(scene: Arc<Scene>, h: f64) -> Result<FiniteDifference, Error> {
-        let h = check("h", h, h > 0.0, "a finite number > 0")?;
-        let displaced = (0..scene.parameters().len())
-            .map(|j| {
-                let step = match scene.parameters()[j].motion {
-                    super::Motion::TranslateX | super::Motion::TranslateY => h * scene.size(),
-                    _ => h,
-                };
-                Ok((scene.displaced(j, step)?, scene.displaced(j, -step)?, step))
+/// Central differences with common random numbers: `I` on the nominal
+/// scene, then per parameter `j` the readings of the scene displaced by
+/// `±h_j` (`h_j = step` × the scene's size for a translation, `step` for a
+/// rotation or a scale), all from one generator state. Errors if a displaced
+/// scene is invalid (shapes touching): the error names the parameter and the
+/// displacement.
+pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDifference, Error> {
+    let step = check("h", step, step > 0.0, "a finite number > 0")?;
+    let pairs = scene
+        .parameters()
+        .iter()
+        .enumerate()
+        .map(|(j, p)| {
+            let (h, note) = match p.motion {
+                super::Motion::TranslateX | super::Motion::TranslateY => (
+                    step * scene.size(),
+                    format!(" (half step {step} × scene size {})", scene.size()),
+                ),
+                _ => (step, String::new()),
+            };
+            let displaced = |delta: f64| -> Result<Box<dyn Estimator>, Error> {
+                let moved = scene
+                    .displaced(j, delta)
+                    .map_err(|e| invalid_displacement("scene", &p.name, delta, &note, e))?;
+                Method::Intensity.estimator(Arc::new(moved))
+            };
+            Ok(Pair {
+                parameter: p.name.clone(),
+                plus: displaced(h)?,
+                minus: displaced(-h)?,
+                half_step: h,
             })
-            .collect::<Result<_, Error>>()?;
-        Ok(FiniteDifference { scene, displaced })
-    }
-}
-
-impl Estimator for FiniteDifference {
-    fn method(&self) -> &'static str {
-        "fd"
-    }
-    fn quantities(&self) -> Vec<Quantity> {
-        sensitivities(&self.scene)
-    }
-    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        let start = rng.clone();
-        weights[0] = reading(&self.scene, rng);
-        for (w, (plus, minus, h)) in weights[1..].iter_mut().zip(&self.displaced) {
-            let p = reading(plus, &mut start.clone());
-            let m = reading(minus, &mut start.clone());
-            *w = (p - m) / (2.0 * h);
-        }
-    }
+        })
+        .collect::<Result<_, Error>>()?;
+    CentralDifference::new(Some(Method::Intensity.estimator(Arc::clone(scene))?), pairs)
 }
 
 /// The expectation method's warp field at the sensor: `V_j(φ)` (rad per
