@@ -227,3 +227,31 @@ fn next_event_estimation_agrees_with_plain_path_tracing() {
         );
     }
 }
+
+#[test]
+fn finite_differences_take_any_number_of_parameters_and_name_a_bad_displacement() {
+    use geosens::Problem;
+    let scene = scene("three_shapes.toml");
+    // I and twelve sensitivities, in declaration order, from one estimator.
+    let fd = Method::Fd.estimator(&scene).unwrap();
+    let names: Vec<String> = scene.parameters().iter().map(|p| p.name.clone()).collect();
+    let want: Vec<Quantity> = std::iter::once(Quantity::Intensity)
+        .chain(names.iter().map(|n| Quantity::sensitivity(n)))
+        .collect();
+    assert_eq!(fd.quantities(), want);
+    // A step that pushes the block into the fog.
+    for e in [
+        scene.estimator(Method::Fd, Some(0.1)).err().unwrap(),
+        finite_difference(&scene, 0.1).err().unwrap(),
+    ] {
+        let e = e.to_string();
+        for w in [
+            "finite differences",
+            "\"block_tx\"",
+            "+0.3",
+            "touch or cross",
+        ] {
+            assert!(e.contains(w), "{w:?} not in {e}");
+        }
+    }
+}
