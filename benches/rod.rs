@@ -16,7 +16,7 @@
 //! - `baseline`: Algorithm 3 as one hand-written loop (`support/baseline.rs`),
 //!   no runner, no trait, sum and sum of squares only;
 //! - `intensity`, `expectation`, `rendering`, `transport`: `geosens::run` of
-//!   each `Method::ALL` estimator with `RunConfig::new(PATHS, SEED)?.threads(1)`.
+//!   each `Method::UNBIASED` estimator with `RunConfig::new(PATHS, SEED)?.threads(1)`.
 //!
 //! `intensity / baseline` is the cost of the generic interface (runner,
 //! trait object, moments to order 4, thread pool); `method / intensity` is the
@@ -67,8 +67,8 @@ fn methods(c: &mut Criterion) {
             let cfg = RunConfig::new(PATHS, SEED)
                 .expect("valid config")
                 .threads(1);
-            for method in Method::ALL {
-                let est = method.estimator(rod, probe);
+            for method in Method::UNBIASED {
+                let est = method.estimator((rod, probe)).expect("estimator");
                 g.bench_function(method.name(), |b| {
                     b.iter(|| run(black_box(est.as_ref()), &cfg).expect("run"))
                 });
@@ -81,7 +81,9 @@ fn methods(c: &mut Criterion) {
 fn overhead(c: &mut Criterion) {
     let rod = Rod::new(2.1, 3.0, 2.0).expect("valid rod");
     let probe = Probe::new(&rod, X, Direction::Left).expect("valid probe");
-    let est = Method::Intensity.estimator(rod, probe);
+    let est = Method::Intensity
+        .estimator((rod, probe))
+        .expect("estimator");
     let cfg = RunConfig::new(2, SEED).expect("valid config").threads(1);
     let mut g = c.benchmark_group("rod/run-overhead");
     g.sample_size(20)

@@ -1,52 +1,134 @@
 //! Central finite differences with common random numbers: the reference
-//! (and the foil) for every derivative estimator. One sample runs the
-//! estimator of the scene at `π + h` and, from a copy of the same generator
-//! state, the estimator at `π − h`, and scores `(w₊ − w₋)/(2h)` per
-//! quantity. Its bias is `O(h²)`; its variance falls with `h` only while the
-//! two paths keep the same structure, and where a path's structure changes
-//! with `π` (here: a collision that moves past the moving end) it grows like
-//! `1/h`. The book's introduction shows both.
+//! (and the foil) for every derivative estimator, on every scene kind. One
+//! sample runs the estimator of the nominal problem (`I`) and, per parameter
+//! `π_j`, the estimators of the problem displaced to `π_j + h_j` and
+//! `π_j − h_j`, all from the same generator state, and scores
+//! `(w₊ − w₋)/(2h_j)`. Its bias is `O(h²)`; its variance falls with `h` only
+//! while the two paths keep the same structure, and where a path's structure
+//! changes with `π` (a collision that moves past the rod's moving end, a ray
+//! that grazes a moving corner) it grows like `1/h`. The book's introduction
+//! shows both.
 use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
 
-/// Most quantities a [`CentralDifference`] differentiates (its per-sample
-/// buffer lives on the stack).
-pub const MAX_QUANTITIES: usize = 8;
+/// Default half step of [`Method::Fd`](crate::Method::Fd): relative to the
+/// scene's size for a translation (the rod's length, flatland's bounding box),
+/// absolute for a rotation (radians) or a scale (relative change).
+pub const DEFAULT_STEP: f64 = 1e-3;
 
-/// `[E(π + h) − E(π − h)] / 2h` with common random numbers.
+/// Checks a half step relative to the scene's size (or in radians, or a
+/// relative scale change), as `--fd-step` takes it: finite and in `(0, 1)`.
+pub fn check_step(h: f64) -> Result<f64, Error> {
+    check(
+        "fd-step",
+        h,
+        h > 0.0 && h < 1.0,
+        "a finite number in (0, 1)",
+    )
+}
+
+/// The error for a problem displaced by `delta` along `parameter` that is
+/// invalid: it says finite differences displaced it, by how much and along
+/// what. `what` names the problem (`"scene"`, `"rod"`), `note` may add how
+/// the displacement was derived from the step.
+pub fn invalid_displacement(
+    what: &str,
+    parameter: &str,
+    delta: f64,
+    note: &str,
+    cause: Error,
+) -> Error {
+    let cause = match cause {
+        Error::Scene(msg) => msg,
+        other => other.to_string(),
+    };
+    // Seven significant digits: 0.1 × 3 reads 0.3, not 0.30000000000000004.
+    let delta: f64 = format!("{delta:.6e}").parse().unwrap_or(delta);
+    Error::Scene(format!(
+        "finite differences: {what} displaced by {delta:+} along parameter \
+         {parameter:?}{note} is invalid: {cause}"
+    ))
+}
+
+/// The problem displaced along one parameter, both ways.
+pub struct Pair {
+    /// The parameter's name: the pair's quantity is `∂I/∂parameter`.
+    pub parameter: String,
+    /// The estimator of `I` at `π + h`.
+    pub plus: Box<dyn Estimator>,
+    /// The estimator of `I` at `π − h`.
+    pub minus: Box<dyn Estimator>,
+    /// The half step `h > 0`, in the parameter's units.
+    pub half_step: f64,
+}
+
+/// `I` from the nominal problem, then `[I(π_j + h_j) − I(π_j − h_j)] / 2h_j`
+/// per parameter, all with common random numbers.
+///
+/// The first run of a sample (the nominal one, or the first pair's `+` run
+/// without a nominal) draws from the chunk's generator itself and so
+/// advances it; every other run draws from a copy of the sample's starting
+/// state. Every run writes one weight into a one-slot buffer on the stack:
+/// no cap on the number of parameters, no allocation per path.
 pub struct CentralDifference {
-    plus: Box<dyn Estimator>,
-    minus: Box<dyn Estimator>,
-    half_step: f64,
+    nominal: Option<Box<dyn Estimator>>,
+    pairs: Vec<Pair>,
+}
+
+/// The only quantity a run of a [`CentralDifference`] may estimate.
+fn intensity_only(e: &dyn Estimator) -> bool {
+    e.quantities() == [Quantity::Intensity]
 }
 
 impl CentralDifference {
-    /// The difference quotient of two estimators of the same quantities, at
-    /// parameters `π ± half_step`; errors if `half_step` is not finite and
-    /// positive or the estimators' quantities differ.
-    pub fn new(
-        plus: Box<dyn Estimator>,
-        minus: Box<dyn Estimator>,
-        half_step: f64,
-    ) -> Result<Self, Error> {
-        let half_step = check("h", half_step, half_step > 0.0, "a finite number > 0")?;
-        if plus.quantities() != minus.quantities() {
+    /// The central differences of `pairs`, with `I` from `nominal` if given.
+    /// Errors if a half step is not finite and positive, an estimator
+    /// estimates anything but `I` alone, two pairs share a parameter, or
+    /// there is nothing to estimate.
+    pub fn new(nominal: Option<Box<dyn Estimator>>, pairs: Vec<Pair>) -> Result<Self, Error> {
+        if nominal.is_none() && pairs.is_empty() {
             return Err(Error::Config(
-                "the two estimators estimate different quantities".into(),
+                "finite differences of nothing: no nominal estimator and no parameter".into(),
             ));
         }
-        if plus.quantities().len() > MAX_QUANTITIES {
+        if let Some(n) = &nominal
+            && !intensity_only(n.as_ref())
+        {
             return Err(Error::Config(format!(
-                "finite differences take at most {MAX_QUANTITIES} quantities"
+                "finite differences: the nominal estimator ({}) must estimate I alone",
+                n.method()
             )));
         }
-        Ok(CentralDifference {
-            plus,
-            minus,
-            half_step,
-        })
+        for (j, p) in pairs.iter().enumerate() {
+            check("h", p.half_step, p.half_step > 0.0, "a finite number > 0")?;
+            if !(intensity_only(p.plus.as_ref()) && intensity_only(p.minus.as_ref())) {
+                return Err(Error::Config(format!(
+                    "finite differences along {:?}: the displaced estimators must estimate I alone",
+                    p.parameter
+                )));
+            }
+            if pairs[..j].iter().any(|q| q.parameter == p.parameter) {
+                return Err(Error::Config(format!(
+                    "finite differences: parameter {:?} appears twice",
+                    p.parameter
+                )));
+            }
+        }
+        Ok(CentralDifference { nominal, pairs })
     }
+}
+
+/// One run's weight of `I`: from `own` (the chunk's generator) if no run of
+/// this sample has used it yet, else from a copy of `start`.
+#[inline]
+fn intensity(e: &dyn Estimator, own: &mut Option<&mut PathRng>, start: &PathRng) -> f64 {
+    let mut w = [0.0];
+    match own.take() {
+        Some(rng) => e.sample(rng, &mut w),
+        None => e.sample(&mut start.clone(), &mut w),
+    }
+    w[0]
 }
 
 impl Estimator for CentralDifference {
@@ -54,21 +136,32 @@ impl Estimator for CentralDifference {
         "fd"
     }
 
-    /// The same quantities as the wrapped estimators, differentiated.
+    /// `I` (with a nominal estimator), then `∂I/∂π_j` per pair.
     fn quantities(&self) -> Vec<Quantity> {
-        self.plus.quantities()
+        self.nominal
+            .iter()
+            .map(|_| Quantity::Intensity)
+            .chain(
+                self.pairs
+                    .iter()
+                    .map(|p| Quantity::sensitivity(&p.parameter)),
+            )
+            .collect()
     }
 
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        // Few quantities: a fixed buffer keeps the hot loop allocation-free.
-        let mut minus = [0.0; MAX_QUANTITIES];
-        let n = weights.len();
-        let mut common = rng.clone();
-        self.plus.sample(rng, weights);
-        self.minus.sample(&mut common, &mut minus[..n]);
-        let scale = 0.5 / self.half_step;
-        for (w, m) in weights.iter_mut().zip(&minus[..n]) {
-            *w = (*w - m) * scale;
+        let start = rng.clone();
+        let mut own = Some(rng);
+        let mut slots = weights.iter_mut();
+        if let Some(nominal) = &self.nominal
+            && let Some(w) = slots.next()
+        {
+            *w = intensity(nominal.as_ref(), &mut own, &start);
+        }
+        for (pair, w) in self.pairs.iter().zip(slots) {
+            let plus = intensity(pair.plus.as_ref(), &mut own, &start);
+            let minus = intensity(pair.minus.as_ref(), &mut own, &start);
+            *w = (plus - minus) / (2.0 * pair.half_step);
         }
     }
 }
@@ -76,19 +169,31 @@ impl Estimator for CentralDifference {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rod::{Direction, Method, Probe, Rod, exact};
+    use crate::Method;
+    use crate::rod::{Direction, PARAMETER, Probe, Rod, exact};
     use crate::runner::{RunConfig, run};
 
     fn intensity(length: f64) -> Box<dyn Estimator> {
         let rod = Rod::new(2.1, 3.0, length).unwrap();
-        Method::Intensity.estimator(rod, Probe::new(&rod, 1.0, Direction::Left).unwrap())
+        let probe = Probe::new(&rod, 1.0, Direction::Left).unwrap();
+        Method::Intensity.estimator((rod, probe)).unwrap()
+    }
+
+    fn pair(name: &str, h: f64) -> Pair {
+        Pair {
+            parameter: name.into(),
+            plus: intensity(2.0 + h),
+            minus: intensity(2.0 - h),
+            half_step: h,
+        }
     }
 
     #[test]
     fn common_random_numbers_recover_the_exact_sensitivity() {
         // h = 3e-3: the O(h²) bias is ~1e-6, far under σ ≈ 2e-4 at 10⁶ paths.
         let h = 3e-3;
-        let fd = CentralDifference::new(intensity(2.0 + h), intensity(2.0 - h), h).unwrap();
+        let fd = CentralDifference::new(None, vec![pair(PARAMETER, h)]).unwrap();
+        assert_eq!(fd.quantities(), [Quantity::sensitivity(PARAMETER)]);
         let e = run(&fd, &RunConfig::new(1_000_000, 5).unwrap())
             .unwrap()
             .estimates[0]
@@ -99,13 +204,50 @@ mod tests {
     }
 
     #[test]
-    fn bad_steps_and_mismatched_estimators_are_rejected() {
+    fn many_parameters_share_one_path_each_way() {
+        // Twelve copies of one pair: more than the old cap of 8 quantities,
+        // and every copy, from the same generator state, gives the same
+        // weight; with the nominal first, `I` matches a plain run.
+        let h = 1e-2;
+        let names: Vec<String> = (0..12).map(|j| format!("p{j}")).collect();
+        let pairs = names.iter().map(|n| pair(n, h)).collect();
+        let fd = CentralDifference::new(Some(intensity(2.0)), pairs).unwrap();
+        assert_eq!(fd.quantities().len(), 13);
+        let cfg = RunConfig::new(20_000, 9).unwrap();
+        let r = run(&fd, &cfg).unwrap();
+        let plain = run(intensity(2.0).as_ref(), &cfg).unwrap();
+        assert_eq!(r.estimates[0].1.mean, plain.estimates[0].1.mean);
+        let s = r.estimates[1].1;
+        assert!(s.stderr > 0.0);
+        for (_, e) in &r.estimates[1..] {
+            assert_eq!(e.mean, s.mean);
+        }
+    }
+
+    #[test]
+    fn bad_steps_and_estimators_are_rejected() {
         for h in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-            assert!(CentralDifference::new(intensity(2.0), intensity(2.0), h).is_err());
+            let p = Pair {
+                half_step: h,
+                ..pair("length", 0.1)
+            };
+            assert!(CentralDifference::new(None, vec![p]).is_err());
         }
         let rod = Rod::new(2.1, 3.0, 2.0).unwrap();
         let probe = Probe::new(&rod, 1.0, Direction::Left).unwrap();
-        let other = Method::Expectation.estimator(rod, probe);
-        assert!(CentralDifference::new(intensity(2.0), other, 0.1).is_err());
+        let other = Method::Expectation.estimator((rod, probe)).unwrap();
+        let p = Pair {
+            minus: other,
+            ..pair("length", 0.1)
+        };
+        assert!(CentralDifference::new(None, vec![p]).is_err());
+        let twice = vec![pair("length", 0.1), pair("length", 0.2)];
+        assert!(CentralDifference::new(None, twice).is_err());
+        assert!(CentralDifference::new(None, vec![]).is_err());
+        for h in [0.0, -1e-3, 1.0, f64::NAN, f64::INFINITY] {
+            let e = check_step(h).unwrap_err().to_string();
+            assert!(e.contains("fd-step"), "{e}");
+        }
+        assert_eq!(check_step(1e-3), Ok(1e-3));
     }
 }

@@ -14,7 +14,9 @@
 //!
 //! Every estimator implements one interface, [`Estimator`]: one call samples one
 //! path (or path pair) and writes its Monte Carlo weights, one per
-//! [`Quantity`]. The [`runner`] turns those weights into [`Estimate`]s (mean,
+//! [`Quantity`]. One [`Method`] enum names the methods on every scene kind, a
+//! [`Problem`] (a probe on a rod, a flatland scene) builds their estimators,
+//! and [`fd`] holds the central differences all of them are checked against. The [`runner`] turns those weights into [`Estimate`]s (mean,
 //! standard error, sample count and a tail diagnostic), in parallel and bit for
 //! bit reproducible from a seed whatever the thread count.
 //!
@@ -35,7 +37,7 @@
 //!
 //! let rod = Rod::new(2.1, 3.0, 2.0)?; // κs, κe, length
 //! let probe = Probe::new(&rod, 1.0, Direction::Left)?;
-//! let estimator = Method::Expectation.estimator(rod, probe);
+//! let estimator = Method::Expectation.estimator((rod, probe))?;
 //! let result = run(estimator.as_ref(), &RunConfig::new(10_000, 7)?)?;
 //! let s = result.get(&Quantity::sensitivity("length")).unwrap();
 //! let exact = geosens::rod::exact::solve(&rod, probe.x, probe.omega);
@@ -49,6 +51,7 @@ pub mod error;
 pub mod estimator;
 pub mod fd;
 pub mod flat;
+pub mod method;
 pub mod path;
 #[cfg(feature = "figures")]
 pub mod plot;
@@ -59,5 +62,6 @@ pub mod stats;
 
 pub use error::Error;
 pub use estimator::{Estimator, Quantity};
+pub use method::{Method, Problem};
 pub use runner::{RunConfig, RunResult, run};
 pub use stats::Estimate;

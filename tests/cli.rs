@@ -60,6 +60,7 @@ fn json_has_exactly_the_documented_keys_and_nulls() {
         ("expectation", [true, true, false]),
         ("rendering", [true, true, false]),
         ("transport", [true, true, true]),
+        ("fd", [true, true, false]),
     ];
     for (method, present) in cases {
         let v = json(method, &["--paths", "1000"]);
@@ -372,4 +373,74 @@ fn compare_without_the_figures_feature_says_so() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("thick rod"));
     assert!(stderr.contains("`figures` feature"), "{stderr}");
     assert!(!dir.exists(), "{} written", dir.display());
+}
+
+/// `geosens rod --method fd` with `extra` arguments at [`PROBE`].
+fn fd_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["rod", "--method", "fd"];
+    args.extend(PROBE);
+    args.extend(extra);
+    args
+}
+
+#[test]
+fn fd_estimates_intensity_and_sensitivity_with_common_random_numbers() {
+    let want = exact_at_probe();
+    for step in [None, Some("0.01")] {
+        let mut extra = vec!["--paths", "200000", "--seed", "3"];
+        extra.extend(step.map(|s| ["--fd-step", s]).into_iter().flatten());
+        let v = json("fd", &extra);
+        assert_eq!(v["method"], "fd");
+        assert!(v["gradient_x"].is_null());
+        for (key, want) in [
+            ("intensity", want.intensity),
+            ("sensitivity", want.sensitivity),
+        ] {
+            let (mean, stderr) = mean_err(&v, key);
+            let z = (mean - want).abs() / stderr;
+            assert!(
+                stderr > 0.0 && z < 5.0,
+                "{step:?} {key}: {mean} ± {stderr} vs {want}"
+            );
+        }
+    }
+    // The step moves the sensitivity, not the nominal rod's I.
+    let line = |extra: &[&str]| {
+        let mut e = vec!["--paths", "20000", "--seed", "5"];
+        e.extend(extra);
+        json("fd", &e)
+    };
+    let (a, b) = (line(&[]), line(&["--fd-step", "0.01"]));
+    assert_eq!(a["intensity"], b["intensity"]);
+    assert_ne!(a["sensitivity"], b["sensitivity"]);
+}
+
+#[test]
+fn bad_fd_steps_are_rejected_with_their_name() {
+    for value in ["0", "-1", "1", "2", "nan", "inf"] {
+        let args = fd_args(&["--paths", "1000", "--fd-step", value]);
+        assert_rejected(&args, 1, &["error: ", "fd-step = ", "(0, 1)"]);
+    }
+    // The shortened rod (2 − 0.12) no longer contains x = 1.9.
+    assert_rejected(
+        &fd_args(&["--paths", "1000", "--fd-step", "0.06"]),
+        1,
+        &[
+            "finite differences",
+            "rod displaced by -0.12 along parameter \"length\"",
+            "x = 1.9",
+            "try a smaller --fd-step",
+        ],
+    );
+    // At the moving end no step helps.
+    let mut end = vec!["rod", "--method", "fd", "--paths", "1000"];
+    end.extend([
+        "--ks", "2.1", "--ke", "3", "--length", "2", "--x", "2", "--omega", "-1",
+    ]);
+    assert_rejected(&end, 1, &["finite differences", "x = 2"]);
+    for method in ["exact", "transport"] {
+        let mut args = vec!["rod", "--method", method, "--fd-step", "0.01"];
+        args.extend(PROBE);
+        assert_rejected(&args, 1, &["--fd-step", "--method fd", method]);
+    }
 }

@@ -116,3 +116,156 @@ fn bad_scene_files_exit_with_a_reason() {
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `geosens flat --json` with `extra` arguments: its JSON line.
+fn flat_json_with(scene_file: &Path, method: &str, extra: &[&str]) -> Value {
+    let mut args = vec!["flat", "--scene", scene_file.to_str().unwrap()];
+    args.extend(["--method", method, "--json"]);
+    args.extend(extra);
+    let out = geosens(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?} failed: {stderr}");
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The JSON line without its wall time.
+fn without_seconds(mut v: Value) -> Value {
+    v.as_object_mut().unwrap().remove("seconds");
+    v
+}
+
+#[test]
+fn fd_differentiates_twelve_parameters_and_agrees_with_expectation() {
+    // 13 quantities, over the old finite-difference cap of 8. Step 10⁻²:
+    // its O(h²) bias is far under these standard errors, and at 10⁻³ a
+    // reflector's grazing paths give the difference heavy tails.
+    let path = scene("three_shapes.toml");
+    let names: Vec<String> = file::load(&path)
+        .unwrap()
+        .parameters()
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    assert_eq!(names.len(), 12);
+    let fd = flat_json_with(
+        &path,
+        "fd",
+        &["--fd-step", "0.01", "--paths", "200000", "--seed", "1"],
+    );
+    let other = flat_json_with(&path, "expectation", &["--paths", "200000", "--seed", "2"]);
+    let s = fd["sensitivity"].as_object().unwrap();
+    assert_eq!(
+        s.keys().collect::<Vec<_>>(),
+        names.iter().collect::<Vec<_>>()
+    );
+    let z = |a: &Value, b: &Value| {
+        let (ma, sa) = (a["mean"].as_f64().unwrap(), a["stderr"].as_f64().unwrap());
+        let (mb, sb) = (b["mean"].as_f64().unwrap(), b["stderr"].as_f64().unwrap());
+        assert!(sa > 0.0 && sb > 0.0, "{a} {b}");
+        (ma - mb).abs() / sa.hypot(sb)
+    };
+    assert!(z(&fd["intensity"], &other["intensity"]) < 4.0);
+    for name in &names {
+        let zj = z(&fd["sensitivity"][name], &other["sensitivity"][name]);
+        assert!(
+            zj < 4.0,
+            "{name}: fd {} vs expectation {}, z = {zj}",
+            fd["sensitivity"][name],
+            other["sensitivity"][name]
+        );
+    }
+}
+
+#[test]
+fn fd_step_sets_the_half_step() {
+    let path = scene("occluder.toml");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["--paths", "20000", "--seed", "3"];
+        args.extend(extra);
+        without_seconds(flat_json_with(&path, "fd", &args))
+    };
+    let default = run(&[]);
+    // The default is 10⁻³, bit for bit.
+    assert_eq!(default, run(&["--fd-step", "0.001"]));
+    let wide = run(&["--fd-step", "0.01"]);
+    // The nominal scene's I is the same paths; every sensitivity moves.
+    assert_eq!(default["intensity"], wide["intensity"]);
+    for (name, s) in default["sensitivity"].as_object().unwrap() {
+        assert_ne!(s["mean"], wide["sensitivity"][name]["mean"], "{name}");
+    }
+}
+
+/// Asserts `geosens flat --scene <file> <args>` fails with status 1 and
+/// every one of `words` on stderr, and prints nothing.
+fn assert_flat_rejected(file: &Path, args: &[&str], words: &[&str]) {
+    let mut all = vec!["flat", "--scene", file.to_str().unwrap()];
+    all.extend(args);
+    let out = geosens(&all);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{all:?}: {stderr}");
+    assert!(out.stdout.is_empty(), "{all:?} printed to stdout");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for w in words {
+        assert!(stderr.contains(w), "{all:?}: {w:?} not in {stderr:?}");
+    }
+}
+
+#[test]
+fn bad_fd_steps_are_rejected_with_their_name() {
+    let path = scene("occluder.toml");
+    for (value, shown) in [
+        ("0", "fd-step = 0"),
+        ("-0.001", "fd-step = -0.001"),
+        ("1", "fd-step = 1"),
+        ("nan", "fd-step = NaN"),
+        ("inf", "fd-step = inf"),
+    ] {
+        assert_flat_rejected(
+            &path,
+            &["--method", "fd", "--paths", "1000", "--fd-step", value],
+            &[shown, "(0, 1)"],
+        );
+    }
+    // A step for a method without one is a mistake, not a no-op.
+    assert_flat_rejected(
+        &path,
+        &[
+            "--method",
+            "rendering",
+            "--paths",
+            "1000",
+            "--fd-step",
+            "0.01",
+        ],
+        &["--fd-step", "--method fd", "rendering"],
+    );
+    let out = geosens(&[
+        "flat",
+        "--scene",
+        path.to_str().unwrap(),
+        "--method",
+        "fd",
+        "--fd-step",
+        "small",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn an_invalid_displaced_scene_names_the_file_the_parameter_and_finite_differences() {
+    // At 10⁻¹ of the scene's size (3), the block moved right by 0.3 crosses
+    // the fog.
+    let path = scene("three_shapes.toml");
+    assert_flat_rejected(
+        &path,
+        &["--method", "fd", "--paths", "1000", "--fd-step", "0.1"],
+        &[
+            "three_shapes.toml",
+            "finite differences",
+            "displaced by +0.3 along parameter \"block_tx\"",
+            "shapes \"block\" and \"fog\" touch or cross",
+            "try a smaller --fd-step",
+        ],
+    );
+}

@@ -6,7 +6,7 @@
 //! higher path count (step 10⁻² of the scene size: its O(h²) bias is far
 //! under the bounds' standard errors wherever the derivative is smooth).
 use geosens::flat::exact::Reference;
-use geosens::flat::methods::FiniteDifference;
+use geosens::flat::methods::finite_difference;
 use geosens::flat::space::Plane;
 use geosens::flat::{Method, Scene, file};
 use geosens::path::intensity::PlainEstimator;
@@ -126,7 +126,7 @@ fn the_intensity_estimator_matches_the_closed_form() {
 /// differences with a 10× larger step at `fd_paths`.
 fn against_finite_differences(name: &str, paths: u64, fd_paths: u64) {
     let scene = scene(name);
-    let fd = FiniteDifference::new(scene.clone(), 1e-2).unwrap();
+    let fd = finite_difference(&scene, 1e-2).unwrap();
     let reference = run(&fd, &RunConfig::new(fd_paths, 99).unwrap()).unwrap();
     for (seed, method) in [Method::Rendering, Method::Expectation, Method::Transport]
         .into_iter()
@@ -229,5 +229,33 @@ fn next_event_estimation_agrees_with_plain_path_tracing() {
             nee.stderr < plain.stderr,
             "{name}: NEE does not serve: {nee:?} vs {plain:?}"
         );
+    }
+}
+
+#[test]
+fn finite_differences_take_any_number_of_parameters_and_name_a_bad_displacement() {
+    use geosens::Problem;
+    let scene = scene("three_shapes.toml");
+    // I and twelve sensitivities, in declaration order, from one estimator.
+    let fd = Method::Fd.estimator(&scene).unwrap();
+    let names: Vec<String> = scene.parameters().iter().map(|p| p.name.clone()).collect();
+    let want: Vec<Quantity> = std::iter::once(Quantity::Intensity)
+        .chain(names.iter().map(|n| Quantity::sensitivity(n)))
+        .collect();
+    assert_eq!(fd.quantities(), want);
+    // A step that pushes the block into the fog.
+    for e in [
+        scene.estimator(Method::Fd, Some(0.1)).err().unwrap(),
+        finite_difference(&scene, 0.1).err().unwrap(),
+    ] {
+        let e = e.to_string();
+        for w in [
+            "finite differences",
+            "\"block_tx\"",
+            "+0.3",
+            "touch or cross",
+        ] {
+            assert!(e.contains(w), "{w:?} not in {e}");
+        }
     }
 }

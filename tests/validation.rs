@@ -78,13 +78,17 @@ fn run_configurations_are_validated() {
         threads: 1,
     };
     names(
-        run(Method::Intensity.estimator(rod, probe).as_ref(), &cfg).unwrap_err(),
+        run(
+            Method::Intensity.estimator((rod, probe)).unwrap().as_ref(),
+            &cfg,
+        )
+        .unwrap_err(),
         "paths",
     );
     // Two paths are enough for an error bar, and every estimate is finite.
-    for method in Method::ALL {
+    for method in Method::UNBIASED {
         let r = run(
-            method.estimator(rod, probe).as_ref(),
+            method.estimator((rod, probe)).unwrap().as_ref(),
             &RunConfig::new(2, 3).unwrap(),
         )
         .unwrap();

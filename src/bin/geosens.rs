@@ -4,6 +4,9 @@
 //!   estimates `I`, `s = ∂I/∂length` (and `∂I/∂x` for `transport`) at one
 //!   probe on a rod with one method, or evaluates the exact solution
 //!   (`--method exact`), and prints a table or one JSON line;
+//! - `geosens flat --scene FILE --method M [--json]` does the same for every
+//!   parameter of a flatland scene file (`--fd-step H` sets the half step of
+//!   `--method fd`, on both subcommands);
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
 //!   and thick rods at a few probes and prints them beside the exact solution,
 //!   then writes the rod's figures and flatland's (`flat_*`) (with the
@@ -11,9 +14,10 @@
 //!
 //! Bad input exits with status 1 and `error: …` naming the value (clap's own
 //! parse errors exit with status 2).
+use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use geosens::rod::{Direction, Method as McMethod, Probe, Rod, exact};
-use geosens::{Error, Estimate, Quantity, RunConfig, RunResult, run};
+use geosens::rod::{Direction, Probe, Rod, exact};
+use geosens::{Error, Estimate, Estimator, Method, Problem, Quantity, RunConfig, RunResult, run};
 use serde::Serialize;
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -52,7 +56,10 @@ struct FlatArgs {
     scene: std::path::PathBuf,
     /// Estimation method.
     #[arg(long, value_enum)]
-    method: FlatMethod,
+    method: Method,
+    /// The finite differences' half step.
+    #[command(flatten)]
+    fd: FdArgs,
     /// The run configuration.
     #[command(flatten)]
     run: RunArgs,
@@ -61,20 +68,40 @@ struct FlatArgs {
     json: bool,
 }
 
-/// `--method` of `geosens flat`.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum FlatMethod {
-    /// Backward path tracing of I only.
-    Intensity,
-    /// Expectation differentiation (warp field): I and s from the same paths.
-    Expectation,
-    /// Differentiable rendering: corner and medium-boundary terms by double
-    /// randomization.
-    Rendering,
-    /// Sensitivity transport, with ∂I/∂x and ∂I/∂y at the sensor.
-    Transport,
-    /// Central finite differences with common random numbers.
-    Fd,
+/// `--fd-step`, shared by `rod` and `flat`.
+#[derive(Debug, Args)]
+struct FdArgs {
+    /// Half step of `--method fd`: relative to the scene's size (the rod's
+    /// length) for a translation, radians for a rotation, the relative
+    /// change for a scale; in (0, 1) [default: 0.001].
+    #[arg(long, allow_hyphen_values = true)]
+    fd_step: Option<f64>,
+}
+
+impl FdArgs {
+    /// `method`'s estimator on `problem`, with `--fd-step` for `fd`. An
+    /// invalid displaced scene's error (`path`: its file, if any) gets a hint.
+    fn estimator(
+        &self,
+        method: Method,
+        problem: impl Problem,
+        path: Option<&std::path::Path>,
+    ) -> Result<Box<dyn Estimator>, Error> {
+        if self.fd_step.is_some() && method != Method::Fd {
+            return Err(Error::Config(format!(
+                "--fd-step sets the half step of --method fd, not of {method}"
+            )));
+        }
+        problem
+            .estimator(method, self.fd_step)
+            .map_err(|e| match e {
+                Error::Scene(msg) if msg.contains("displaced by") => {
+                    let file = path.map_or(String::new(), |p| format!("{}: ", p.display()));
+                    Error::Scene(format!("{file}{msg}; try a smaller --fd-step"))
+                }
+                other => other,
+            })
+    }
 }
 
 /// How to estimate: the method, the rod, the probe and the run. Float values
@@ -85,7 +112,7 @@ enum FlatMethod {
 struct RodArgs {
     /// Estimation method (`exact` evaluates the Bellman–Wing solution).
     #[arg(long, value_enum)]
-    method: Method,
+    method: RodMethod,
     /// Scattering coefficient κs (≥ 0).
     #[arg(long, allow_hyphen_values = true)]
     ks: f64,
@@ -101,6 +128,9 @@ struct RodArgs {
     /// Probe direction ω: 1 (right) or -1 (left).
     #[arg(long, allow_hyphen_values = true)]
     omega: f64,
+    /// The finite differences' half step.
+    #[command(flatten)]
+    fd: FdArgs,
     /// The run configuration.
     #[command(flatten)]
     run: RunArgs,
@@ -156,30 +186,29 @@ impl RunArgs {
     }
 }
 
-/// `--method`: the exact solution or one of the four Monte Carlo methods.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum Method {
-    /// Exact Bellman–Wing solution.
-    Exact,
-    /// Backward path tracing of I only.
-    Intensity,
-    /// Expectation differentiation: I and s from the same paths.
-    Expectation,
-    /// Differentiable rendering with double randomization.
-    Rendering,
-    /// Coupled transport of I, s and ∂I/∂x.
-    Transport,
-}
+/// `--method` of `geosens rod`: a Monte Carlo [`Method`] or, listed first,
+/// `exact`, the Bellman–Wing solution (`None`).
+#[derive(Debug, Clone, Copy)]
+struct RodMethod(Option<Method>);
 
-impl Method {
-    /// The library's Monte Carlo method, `None` for `exact`.
-    fn monte_carlo(self) -> Option<McMethod> {
-        match self {
-            Method::Exact => None,
-            Method::Intensity => Some(McMethod::Intensity),
-            Method::Expectation => Some(McMethod::Expectation),
-            Method::Rendering => Some(McMethod::Rendering),
-            Method::Transport => Some(McMethod::Transport),
+impl ValueEnum for RodMethod {
+    fn value_variants<'a>() -> &'a [Self] {
+        const ALL: [RodMethod; 1 + Method::ALL.len()] = {
+            let mut all = [RodMethod(None); 1 + Method::ALL.len()];
+            let mut i = 0;
+            while i < Method::ALL.len() {
+                all[i + 1] = RodMethod(Some(Method::ALL[i]));
+                i += 1;
+            }
+            all
+        };
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        match self.0 {
+            None => Some(PossibleValue::new("exact").help("Exact Bellman–Wing solution")),
+            Some(m) => m.to_possible_value(),
         }
     }
 }
@@ -273,8 +302,14 @@ fn rod_command(args: &RodArgs, out: &mut impl Write) -> Result<(), Box<dyn std::
     let rod = Rod::new(args.ks, args.ke, args.length)?;
     let probe = Probe::new(&rod, args.x, Direction::from_sign(args.omega)?)?;
     let cfg = args.run.config(1_000_000)?;
-    let result = match args.method.monte_carlo() {
-        Some(m) => run(m.estimator(rod, probe).as_ref(), &cfg)?,
+    let result = match args.method.0 {
+        Some(m) => run(args.fd.estimator(m, (rod, probe), None)?.as_ref(), &cfg)?,
+        None if args.fd.fd_step.is_some() => {
+            return Err(Error::Config(
+                "--fd-step sets the half step of --method fd, not of exact".into(),
+            )
+            .into());
+        }
         None => exact_result(&rod, &probe),
     };
     all_finite(&result)?;
@@ -424,8 +459,8 @@ fn compare_command(
                 let ex = exact_values(&rod, &probe);
                 let label = format!("{x}, {:+}", omega.sign());
                 writeln!(out, "{}", row(&label, &exact_result(&rod, &probe), &ex))?;
-                for (m, total) in McMethod::ALL.iter().zip(&mut totals) {
-                    let r = run(m.estimator(rod, probe).as_ref(), &cfg)?;
+                for (m, total) in Method::UNBIASED.iter().zip(&mut totals) {
+                    let r = run(m.estimator((rod, probe))?.as_ref(), &cfg)?;
                     writeln!(out, "{}", row("", &r, &ex))?;
                     total.0 += r.seconds;
                     for (q, e) in &r.estimates {
@@ -447,7 +482,7 @@ fn compare_command(
         "{:<12} {:>9} {:>7} {:>11}",
         "method", "time [s]", "max z", "unreliable"
     )?;
-    for (m, (seconds, z, bad)) in McMethod::ALL.iter().zip(totals) {
+    for (m, (seconds, z, bad)) in Method::UNBIASED.iter().zip(totals) {
         writeln!(out, "{:<12} {seconds:>9.3} {z:>7.1} {bad:>11}", m.name())?;
     }
     writeln!(
@@ -507,17 +542,12 @@ struct FlatJsonLine<'a> {
 
 /// `geosens flat`.
 fn flat_command(args: &FlatArgs, out: &mut impl Write) -> Result<(), Box<dyn std::error::Error>> {
-    use geosens::flat::{Method as Flat, file};
-    let scene = std::sync::Arc::new(file::load(&args.scene)?);
-    let method = match args.method {
-        FlatMethod::Intensity => Flat::Intensity,
-        FlatMethod::Expectation => Flat::Expectation,
-        FlatMethod::Rendering => Flat::Rendering,
-        FlatMethod::Transport => Flat::Transport,
-        FlatMethod::Fd => Flat::Fd,
-    };
+    let scene = std::sync::Arc::new(geosens::flat::file::load(&args.scene)?);
     let cfg = args.run.config(1_000_000)?;
-    let result = run(method.estimator(scene.clone())?.as_ref(), &cfg)?;
+    let estimator = args
+        .fd
+        .estimator(args.method, scene.clone(), Some(&args.scene))?;
+    let result = run(estimator.as_ref(), &cfg)?;
     all_finite(&result)?;
     if args.json {
         let value = |e: &Estimate| {

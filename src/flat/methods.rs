@@ -9,63 +9,39 @@
 //!   [`crate::path::expectation`], [`crate::path::transport`]) over the
 //!   plane's geometry ([`Plane`]);
 //! - [`Method::Fd`]: central differences with common random numbers, one
-//!   pair of displaced scenes per parameter.
+//!   pair of displaced scenes per parameter ([`finite_difference`], built on
+//!   [`crate::fd`]).
 use super::scene::Scene;
 use super::space::Plane;
 use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
+use crate::fd::{CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement};
+use crate::method::Problem;
 use crate::path::deform::Slots;
-use crate::path::estimator::{DerivativeEstimator, Scheme, reading};
+use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::intensity::IntensityEstimator;
-use crate::rng::PathRng;
 use std::sync::Arc;
 
-/// A flatland estimation method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// Backward path tracing of `I` only.
-    Intensity,
-    /// Expectation differentiation: the warp field and stretched free paths;
-    /// `I` and every `∂I/∂π` from the same path.
-    Expectation,
-    /// Differentiable rendering: boundary terms at corners and medium
-    /// boundaries, joined by double randomisation.
-    Rendering,
-    /// Sensitivity transport: the path stays fixed in space; sources where
-    /// it meets moving boundaries, coupled to the radiance gradient there
-    /// (nested walks); also returns `∂I/∂x`, `∂I/∂y` at the sensor.
-    Transport,
-    /// Central finite differences with common random numbers (half step
-    /// [`FD_STEP`] × scene size for translations, [`FD_STEP`] for rotations
-    /// and scales).
-    Fd,
-}
+/// The methods: every [`Method`] runs on a flatland scene
+/// (`method.estimator(scene)` with `scene: Arc<Scene>`).
+pub use crate::method::Method;
 
-/// Half step of [`Method::Fd`], relative to the scene size (radians for a
-/// rotation, relative change for a scale).
-pub const FD_STEP: f64 = 1e-3;
-
-impl Method {
-    /// The method's name, as the CLI spells it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Intensity => "intensity",
-            Method::Expectation => "expectation",
-            Method::Rendering => "rendering",
-            Method::Transport => "transport",
-            Method::Fd => "fd",
-        }
-    }
-
-    /// The estimator of this method on `scene`.
-    pub fn estimator(self, scene: Arc<Scene>) -> Result<Box<dyn Estimator>, Error> {
-        let scheme = match self {
+impl Problem for Arc<Scene> {
+    /// For [`Method::Fd`] the half step is `fd_step` times the scene's size
+    /// for a translation, `fd_step` radians for a rotation and `fd_step` for a
+    /// scale.
+    fn estimator(&self, method: Method, fd_step: Option<f64>) -> Result<Box<dyn Estimator>, Error> {
+        let scene = Arc::clone(self);
+        let scheme = match method {
             Method::Intensity => {
                 return Ok(Box::new(IntensityEstimator {
                     geometry: Plane::new(scene),
                 }));
             }
-            Method::Fd => return Ok(Box::new(FiniteDifference::new(scene, FD_STEP)?)),
+            Method::Fd => {
+                let step = fd_step.map_or(Ok(DEFAULT_STEP), check_step)?;
+                return Ok(Box::new(finite_difference(&scene, step)?));
+            }
             Method::Expectation => Scheme::Expectation,
             Method::Rendering => Scheme::Rendering,
             Method::Transport => Scheme::Transport,
@@ -96,66 +72,41 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
     }
 }
 
-/// `I` then one sensitivity per parameter.
-fn sensitivities(scene: &Scene) -> Vec<Quantity> {
-    std::iter::once(Quantity::Intensity)
-        .chain(
-            scene
-                .parameters()
-                .iter()
-                .map(|p| Quantity::sensitivity(&p.name)),
-        )
-        .collect()
-}
-
-/// Central differences with common random numbers: per parameter `j`, the
-/// reading of the scene displaced by `±h_j` from copies of one generator
-/// state; `I` from the nominal scene with the same state.
-pub struct FiniteDifference {
-    nominal: Plane,
-    displaced: Vec<(Plane, Plane, f64)>,
-}
-
-impl FiniteDifference {
-    /// Half step `h` relative to the scene size for translations and
-    /// absolute for rotations (radians) and scales; errors if `h` is not
-    /// finite and positive or a displaced scene is invalid (shapes touching).
-    pub fn new(scene: Arc<Scene>, h: f64) -> Result<FiniteDifference, Error> {
-        let h = check("h", h, h > 0.0, "a finite number > 0")?;
-        let displaced = (0..scene.parameters().len())
-            .map(|j| {
-                let step = match scene.parameters()[j].motion {
-                    super::Motion::TranslateX | super::Motion::TranslateY => h * scene.size(),
-                    _ => h,
-                };
-                let plus = Plane::new(Arc::new(scene.displaced(j, step)?));
-                let minus = Plane::new(Arc::new(scene.displaced(j, -step)?));
-                Ok((plus, minus, step))
+/// Central differences with common random numbers: `I` on the nominal
+/// scene, then per parameter `j` the readings of the scene displaced by
+/// `±h_j` (`h_j = step` × the scene's size for a translation, `step` for a
+/// rotation or a scale), all from one generator state. Errors if a displaced
+/// scene is invalid (shapes touching): the error names the parameter and the
+/// displacement.
+pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDifference, Error> {
+    let step = check("h", step, step > 0.0, "a finite number > 0")?;
+    let pairs = scene
+        .parameters()
+        .iter()
+        .enumerate()
+        .map(|(j, p)| {
+            let (h, note) = match p.motion {
+                super::Motion::TranslateX | super::Motion::TranslateY => (
+                    step * scene.size(),
+                    format!(" (half step {step} × scene size {})", scene.size()),
+                ),
+                _ => (step, String::new()),
+            };
+            let displaced = |delta: f64| -> Result<Box<dyn Estimator>, Error> {
+                let moved = scene
+                    .displaced(j, delta)
+                    .map_err(|e| invalid_displacement("scene", &p.name, delta, &note, e))?;
+                Method::Intensity.estimator(Arc::new(moved))
+            };
+            Ok(Pair {
+                parameter: p.name.clone(),
+                plus: displaced(h)?,
+                minus: displaced(-h)?,
+                half_step: h,
             })
-            .collect::<Result<_, Error>>()?;
-        Ok(FiniteDifference {
-            nominal: Plane::new(scene),
-            displaced,
         })
-    }
-}
-
-impl Estimator for FiniteDifference {
-    fn method(&self) -> &'static str {
-        "fd"
-    }
-    fn quantities(&self) -> Vec<Quantity> {
-        sensitivities(self.nominal.scene())
-    }
-    fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        let start = rng.clone();
-        weights[0] = reading(&self.nominal, &mut (), rng).0;
-        for (w, (plus, minus, h)) in weights[1..].iter_mut().zip(&self.displaced) {
-            let p = reading(plus, &mut (), &mut start.clone()).0;
-            let m = reading(minus, &mut (), &mut start.clone()).0;
-            *w = (p - m) / (2.0 * h);
-        }
-    }
+        .collect::<Result<_, Error>>()?;
+    CentralDifference::new(Some(Method::Intensity.estimator(Arc::clone(scene))?), pairs)
 }
 
 /// The expectation method's warp field at the sensor: `V_j(φ)` (rad per

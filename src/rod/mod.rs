@@ -11,6 +11,8 @@
 //! exact solution".
 use crate::error::{Error, check};
 use crate::estimator::Estimator;
+use crate::fd::{CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement};
+use crate::method::Problem;
 
 pub mod exact;
 pub mod expectation;
@@ -180,47 +182,60 @@ impl Probe {
     }
 }
 
-/// The four Monte Carlo methods on the rod.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Backward path tracing of `I` (Algorithm 3).
-    Intensity,
-    /// Expectation differentiation: `I` and `s` from the same paths (Algorithm 4).
-    Expectation,
-    /// Differentiable rendering with double randomization (Algorithm 5).
-    Rendering,
-    /// The coupled transport models `{I, s, ∂xI}` (Eqs. 41–43).
-    Transport,
-}
+/// The methods: every [`Method`] runs on a rod (`method.estimator((rod,
+/// probe))`): intensity (Algorithm 3), expectation (Algorithm 4), rendering
+/// (Algorithm 5), transport (the coupled models `{I, s, ∂xI}` of Eqs. 41–43)
+/// and central finite differences in the length.
+pub use crate::method::Method;
 
-impl Method {
-    /// All four, in the order the comparison tables print them.
-    pub const ALL: [Method; 4] = [
-        Method::Intensity,
-        Method::Expectation,
-        Method::Rendering,
-        Method::Transport,
-    ];
-
-    /// The method's name, as the CLI spells it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Intensity => "intensity",
-            Method::Expectation => "expectation",
-            Method::Rendering => "rendering",
-            Method::Transport => "transport",
-        }
-    }
-
-    /// The estimator of this method for `probe` on `rod`.
-    pub fn estimator(self, rod: Rod, probe: Probe) -> Box<dyn Estimator> {
-        match self {
+impl Problem for (Rod, Probe) {
+    /// For [`Method::Fd`] the half step is `fd_step` times the rod's length.
+    fn estimator(&self, method: Method, fd_step: Option<f64>) -> Result<Box<dyn Estimator>, Error> {
+        let (rod, probe) = *self;
+        Ok(match method {
             Method::Intensity => Box::new(intensity::IntensityEstimator { rod, probe }),
             Method::Expectation => Box::new(expectation::ExpectationEstimator { rod, probe }),
             Method::Rendering => Box::new(rendering::RenderingEstimator { rod, probe }),
             Method::Transport => Box::new(transport::TransportEstimator { rod, probe }),
-        }
+            Method::Fd => Box::new(finite_difference(
+                rod,
+                probe,
+                fd_step.map_or(Ok(DEFAULT_STEP), check_step)?,
+            )?),
+        })
     }
+}
+
+/// Central differences in the length with common random numbers: `I` at
+/// `probe`, then `[I(π̃ + h) − I(π̃ − h)]/2h` with `h = step × π̃`; errors if
+/// the probe is at the moving end (`x = π̃`) or a displaced rod is invalid
+/// (the probe beyond the shortened rod's end, the lengthened rod too thick).
+pub fn finite_difference(rod: Rod, probe: Probe, step: f64) -> Result<CentralDifference, Error> {
+    if probe.x >= rod.length {
+        return Err(Error::Scene(format!(
+            "finite differences in the length need the probe inside the rod \
+             (x < length): at x = {} no shortened rod contains it",
+            probe.x
+        )));
+    }
+    let h = step * rod.length;
+    let displaced = |delta: f64| -> Result<Box<dyn Estimator>, Error> {
+        let moved = Rod::new(rod.ks, rod.ke, rod.length + delta)
+            .and_then(|r| r.with_incoming(rod.incoming))
+            .and_then(|r| Ok((r, Probe::new(&r, probe.x, probe.omega)?)))
+            .map_err(|e| {
+                let note = format!(" (half step {step} × length {})", rod.length);
+                invalid_displacement("rod", PARAMETER, delta, &note, e)
+            })?;
+        Method::Intensity.estimator(moved)
+    };
+    let pair = Pair {
+        parameter: PARAMETER.to_owned(),
+        plus: displaced(h)?,
+        minus: displaced(-h)?,
+        half_step: h,
+    };
+    CentralDifference::new(Some(Method::Intensity.estimator((rod, probe))?), vec![pair])
 }
 
 /// The name of the rod's shape parameter in estimator outputs.

@@ -24,7 +24,7 @@ pub fn estimate(
 ) -> RunResult {
     let probe = Probe::new(&rod, x, omega).unwrap();
     let cfg = RunConfig::new(paths, seed).unwrap().threads(1);
-    run(method.estimator(rod, probe).as_ref(), &cfg).unwrap()
+    run(method.estimator((rod, probe)).unwrap().as_ref(), &cfg).unwrap()
 }
 
 /// The exact value of `q` at `(x, omega)`.

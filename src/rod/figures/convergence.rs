@@ -60,6 +60,7 @@ pub(super) fn style(method: Method) -> (String, usize) {
         Method::Expectation => 1,
         Method::Rendering => 2,
         Method::Transport => 3,
+        Method::Fd => 4,
     };
     (format!("{} ({})", method.name(), judged(method)), color)
 }
@@ -173,7 +174,7 @@ pub(super) fn error_panel(
     x_of: fn(&Record) -> f64,
 ) -> Panel {
     let mut series = Vec::new();
-    for method in Method::ALL {
+    for method in Method::UNBIASED {
         let mut rs: Vec<&Record> = records
             .iter()
             .filter(|r| r.method == method.name())
@@ -230,7 +231,7 @@ pub(super) const FALLING: [Legend; 2] = [Legend::LowerLeft, Legend::UpperRight];
 /// and the numbers to `convergence.json`.
 pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let counts = path_counts(2, 7);
-    let runs = PROBES.len() * 2 * Method::ALL.len() * counts.len();
+    let runs = PROBES.len() * 2 * Method::UNBIASED.len() * counts.len();
     let bar = opts.bar(runs as u64, "convergence");
     let mut records = Vec::with_capacity(runs);
     let mut panels = Vec::new();
@@ -244,7 +245,7 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
                 omega,
             };
             let first = records.len();
-            for method in Method::ALL {
+            for method in Method::UNBIASED {
                 for &n in &counts {
                     salt += 1;
                     records.push(Record::measure(opts, method, case, n, salt)?);

@@ -53,7 +53,7 @@ pub struct Efficiency {
 /// dots; zero-variance points, `σ = 0`, cannot be drawn on the log axis).
 fn work_panel(title: String, records: &[Record]) -> Panel {
     let mut series = Vec::new();
-    for method in Method::ALL {
+    for method in Method::UNBIASED {
         let (label, color) = style(method);
         let xy: Vec<(f64, f64)> = records
             .iter()
@@ -114,7 +114,7 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     };
     let counts = path_counts(3, 7);
     let directions = [Direction::Left, Direction::Right];
-    let methods = Method::ALL.len();
+    let methods = Method::UNBIASED.len();
     let runs = methods * 2 * (directions.len() * (POSITIONS + 1) + counts.len());
     let bar = opts.bar(runs as u64, "efficiency");
     let mut salt = SALT;
@@ -131,7 +131,7 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             xs.push(NEAR_END);
             xs.sort_by(f64::total_cmp);
             let first = work.len();
-            for method in Method::ALL {
+            for method in Method::UNBIASED {
                 for &x in &xs {
                     let case = Case {
                         rod_name,
@@ -161,7 +161,7 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             omega,
         };
         let first = error_vs_time.len();
-        for method in Method::ALL {
+        for method in Method::UNBIASED {
             for &n in &counts {
                 error_vs_time.push(measure(method, case, n)?);
             }

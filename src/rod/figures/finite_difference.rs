@@ -18,7 +18,7 @@
 use super::{FigureOptions, thick};
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
-use crate::fd::CentralDifference;
+use crate::fd::{CentralDifference, Pair};
 use crate::plot::{Figure, Legend, Panel, Series};
 use crate::rod::{Direction, Method, PARAMETER, Probe, Rod, exact};
 use crate::runner::{RunConfig, run};
@@ -90,7 +90,7 @@ fn stretched(dl: f64) -> Rod {
 
 /// `method`'s estimator at the probe on `rod`.
 fn estimator(method: Method, rod: Rod) -> Result<Box<dyn Estimator>, Error> {
-    Ok(method.estimator(rod, Probe::new(&rod, PROBE.0, PROBE.1)?))
+    method.estimator((rod, Probe::new(&rod, PROBE.0, PROBE.1)?))
 }
 
 /// The exact bias of the central difference with half step `h`, or `None`
@@ -152,11 +152,14 @@ pub fn finite_difference(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         };
         points.push(point("independent", h, independent, exact));
         // Common random numbers: one run of the per-path difference.
-        let fd = CentralDifference::new(
-            estimator(Method::Intensity, plus)?,
-            estimator(Method::Intensity, minus)?,
-            h,
-        )?;
+        // No nominal run: the `+` run draws from the chunk's generator.
+        let pair = Pair {
+            parameter: PARAMETER.to_owned(),
+            plus: estimator(Method::Intensity, plus)?,
+            minus: estimator(Method::Intensity, minus)?,
+            half_step: h,
+        };
+        let fd = CentralDifference::new(None, vec![pair])?;
         let common = run(&fd, &cfg(salt)?)?.estimates[0].1;
         points.push(point("common", h, common, exact));
         bar.inc(1);

@@ -108,7 +108,7 @@ impl FigureOptions {
         let probe = Probe::new(&rod, x, omega)?;
         let cfg =
             RunConfig::new(self.paths(paths), self.seed.wrapping_add(salt))?.threads(self.threads);
-        run(method.estimator(rod, probe).as_ref(), &cfg)
+        run(method.estimator((rod, probe))?.as_ref(), &cfg)
     }
 }
 

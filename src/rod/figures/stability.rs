@@ -128,7 +128,7 @@ fn measure(opts: &FigureOptions, site: Site, salt: u64) -> Result<Cell, Error> {
     let x = site.position * LENGTH;
     let probe = Probe::new(&rod, x, site.omega)?;
     let reference = exact::solve(&rod, x, site.omega).sensitivity;
-    let estimator = site.method.estimator(rod, probe);
+    let estimator = site.method.estimator((rod, probe))?;
     let q = Quantity::sensitivity(PARAMETER);
     let paths = opts.paths(PATHS);
     let (mut within2, mut within3, mut flagged, mut silent, mut zero) = (0, 0, 0, 0, 0);
