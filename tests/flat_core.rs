@@ -5,7 +5,9 @@
 //! evaluated exactly at the corner, not by two rays at ±10⁻⁷ rad).
 use geosens::flat::exact::Reference;
 use geosens::flat::figures::stability;
+use geosens::flat::space::Plane;
 use geosens::flat::{Method, Motion, Parameter, Scene, Sensor, Shape, Surface};
+use geosens::path::intensity::PlainEstimator;
 use geosens::{Quantity, RunConfig, run};
 use glam::DVec2;
 use std::sync::Arc;
@@ -233,4 +235,60 @@ fn too_many_parameters_is_a_clear_error() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("254 parameters: at most 253"), "{e}");
+}
+
+#[test]
+fn a_thick_conservative_fog_does_not_collapse_to_zero() {
+    // κs = κe = 20 over a box 2 wide around the sensor: paths need ~10³
+    // collisions to leave it. A survival probability capped at 0.95 per
+    // event returned ~0 with a small error bar; roulette on the weight lets
+    // every path walk out. Two independent estimators of I agree.
+    let fog = Shape {
+        name: "fog".into(),
+        vertices: vec![
+            DVec2::new(-1.0, -0.5),
+            DVec2::new(1.0, -0.5),
+            DVec2::new(1.0, 1.5),
+            DVec2::new(-1.0, 1.5),
+        ],
+        closed: true,
+        surface: Surface::Transparent,
+        medium: Some(geosens::flat::Medium {
+            ks: 20.0,
+            ke: 20.0,
+            phase: geosens::flat::Phase::Isotropic,
+        }),
+    };
+    let scene = Arc::new(
+        Scene::new(
+            vec![
+                segment(
+                    "lamp",
+                    [-1.0, 2.0],
+                    [1.0, 2.0],
+                    Surface::Emitter { radiance: 1.0 },
+                ),
+                fog,
+            ],
+            vec![],
+            irradiance_up(),
+        )
+        .unwrap(),
+    );
+    let cfg = RunConfig::new(20_000, 2).unwrap();
+    let e = Method::Intensity.estimator(scene.clone()).unwrap();
+    let nee = run(e.as_ref(), &cfg)
+        .unwrap()
+        .get(&Quantity::Intensity)
+        .unwrap();
+    let plain = PlainEstimator {
+        geometry: Plane::new(scene),
+    };
+    let plain = run(&plain, &cfg)
+        .unwrap()
+        .get(&Quantity::Intensity)
+        .unwrap();
+    assert!(nee.stderr < 0.05 * nee.mean, "{nee:?}");
+    let z = (nee.mean - plain.mean).abs() / nee.stderr.hypot(plain.stderr);
+    assert!(z < 4.0, "NEE {nee:?} vs plain {plain:?}");
 }

@@ -41,7 +41,10 @@ impl Boundaries for Plane {
         if total <= 0.0 {
             return None;
         }
-        let pick = cdf.partition_point(|&c| c <= u * total).min(cdf.len() - 1);
+        // Below the total even when u·total rounds up to it, so that a
+        // corner of weight 0 at the end is never picked.
+        let s = (u * total).min(total * (1.0 - f64::EPSILON));
+        let pick = cdf.partition_point(|&c| c <= s).min(cdf.len() - 1);
         let index = if all {
             pick as u32
         } else {

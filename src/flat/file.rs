@@ -85,9 +85,37 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
             )));
         }
     };
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::Scene(format!("cannot read scene file {}: {e}", path.display())))?;
+    let text = read_capped(path)?;
     parse(&text).map_err(in_file)
+}
+
+/// Largest scene file read (bytes): a path that names an endless stream
+/// (a link to `/dev/zero`, a pipe) stops there instead of filling memory.
+pub const MAX_SCENE_BYTES: u64 = 256 << 20;
+
+/// The text of the file at `path`, at most [`MAX_SCENE_BYTES`] long.
+fn read_capped(path: &Path) -> Result<String, Error> {
+    use std::io::Read;
+    let cannot =
+        |e: std::io::Error| Error::Scene(format!("cannot read scene file {}: {e}", path.display()));
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(Error::Scene(format!(
+            "scene file {} is larger than {} MiB (or an endless stream): not read",
+            path.display(),
+            MAX_SCENE_BYTES >> 20
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        Error::Scene(format!(
+            "cannot read scene file {}: not UTF-8 text ({e})",
+            path.display()
+        ))
+    })
 }
 
 /// Parses and validates a TOML scene.

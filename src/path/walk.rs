@@ -12,9 +12,16 @@ use rand::RngExt;
 
 /// Events after which Russian roulette starts.
 pub const ROULETTE_DEPTH: u32 = 5;
-/// Highest survival probability of the roulette: a path in a lossless
-/// enclosure still ends.
+/// Highest survival probability of the roulette after
+/// [`ROULETTE_CAP_DEPTH`] events: a path in a lossless enclosure still ends.
 pub const ROULETTE_CAP: f64 = 0.95;
+/// Events after which the survival probability is capped at
+/// [`ROULETTE_CAP`]. Before, a path survives with probability `min(1, β)`:
+/// in a thick conservative medium (β stays 1) it walks until it leaves,
+/// ~τ² events for optical thickness τ, instead of dying after a few hundred
+/// (a fixed cap of 0.95 per event made the estimate collapse to 0 from
+/// τ ≈ 50 on, with an error bar that could not see it).
+pub const ROULETTE_CAP_DEPTH: u32 = 100_000;
 
 /// The frame a scattering vertex's lobe is attached to: it decides how a
 /// direction drawn there turns when the parameters change.
@@ -141,7 +148,15 @@ pub fn survives(depth: u32, beta: &mut f64, rng: &mut PathRng) -> bool {
     if depth < ROULETTE_DEPTH {
         return true;
     }
-    let q = beta.abs().min(ROULETTE_CAP);
+    let cap = if depth < ROULETTE_CAP_DEPTH {
+        1.0
+    } else {
+        ROULETTE_CAP
+    };
+    let q = beta.abs().min(cap);
+    if q >= 1.0 {
+        return true;
+    }
     if q <= 0.0 || rng.random::<f64>() >= q {
         return false;
     }

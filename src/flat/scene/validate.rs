@@ -405,9 +405,33 @@ fn check_optical_thickness(shapes: &[Shape], size: f64) -> Result<(), Error> {
                 m.ke * size
             ));
         }
+        // A path in a medium scatters about min(τs², κs/κa) times before it
+        // leaves or the roulette ends it (its weight falls by e^{−κa/κs} per
+        // event): beyond MAX_SCATTERING_EVENTS a run would not end.
+        if let Some(m) = s.medium {
+            let tau = m.ks * size;
+            let ka = m.ke - m.ks;
+            let events = if ka > 0.0 {
+                (tau * tau).min(m.ks / ka)
+            } else {
+                tau * tau
+            };
+            if events > MAX_SCATTERING_EVENTS {
+                return config(format!(
+                    "shape {:?}: κs × scene size = {tau:.4e} with albedo {:.6}: a path would \
+                     scatter ~{events:.1e} times (at most {MAX_SCATTERING_EVENTS:e} are \
+                     supported); lower κs or raise the absorption",
+                    s.name,
+                    m.ks / m.ke
+                ));
+            }
+        }
     }
     Ok(())
 }
+
+/// Most scattering events a path is expected to need in one medium.
+pub const MAX_SCATTERING_EVENTS: f64 = 1e5;
 
 /// The medium shape around each medium shape, and the one around the
 /// sensor at `p`.
