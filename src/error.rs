@@ -7,7 +7,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum Error {
     /// A numeric parameter is out of its domain (or not finite).
-    #[error("invalid {name} = {value}: expected {expected}")]
+    #[error("invalid {name} = {}: expected {expected}", Num(*value))]
     InvalidParameter {
         /// Name of the parameter, as the CLI and the docs spell it.
         name: &'static str,
@@ -43,5 +43,42 @@ pub(crate) fn check(
             value,
             expected,
         })
+    }
+}
+
+/// A number as a person reads it: plain between 10⁻⁴ and 10¹⁵, in
+/// scientific notation beyond (Rust's `{}` writes `1e300` with 301 digits),
+/// always the shortest form that reads back to the same `f64`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_print_short() {
+        assert_eq!(Num(1e300).to_string(), "1e300");
+        assert_eq!(Num(-2.5e-200).to_string(), "-2.5e-200");
+        assert_eq!(Num(0.1).to_string(), "0.1");
+        assert_eq!(Num(123456.5).to_string(), "123456.5");
+        assert_eq!(Num(f64::NAN).to_string(), "NaN");
+        let e = Error::InvalidParameter {
+            name: "ke",
+            value: 1e300,
+            expected: "x",
+        };
+        assert!(e.to_string().len() < 40, "{e}");
     }
 }

@@ -161,13 +161,15 @@ struct CompareArgs {
 struct RunArgs {
     /// Number of paths per run, at least 2 [default: 1000000 for `rod`,
     /// 200000 for `compare`] (`exact` samples none but checks it too).
-    #[arg(long)]
+    // Hyphen values allowed so that `--paths -5` is named in the error
+    // ("invalid value '-5' for '--paths'") instead of an unexpected `-5`.
+    #[arg(long, allow_hyphen_values = true)]
     paths: Option<u64>,
     /// Seed of the random streams.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Worker threads, 0 = all cores (results do not depend on it).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     threads: usize,
 }
 

@@ -8,7 +8,7 @@ use super::{
     BVH_THRESHOLD, GRID_THRESHOLD, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion,
     Parameter, Phase, Scene, Sensor, Shape, Surface, config,
 };
-use crate::error::Error;
+use crate::error::{Error, Num};
 use crate::flat::corners::CornerGrid;
 use crate::flat::geometry::{
     LinearScan, NO_SEGMENT, RayCast, Segment, contains, cross, signed_area,
@@ -86,7 +86,11 @@ fn unit(what: &str, v: DVec2) -> Result<DVec2, Error> {
     if n > 0.0 && n.is_finite() {
         Ok(u / n)
     } else {
-        config(format!("{what} = [{}, {}] has no direction", v.x, v.y))
+        config(format!(
+            "{what} = [{}, {}] has no direction",
+            Num(v.x),
+            Num(v.y)
+        ))
     }
 }
 
@@ -167,12 +171,16 @@ fn check_shape(k: usize, s: &Shape, repeated: bool) -> Result<(), Error> {
 
 fn check_surface(name: &str, s: &Surface) -> Result<(), Error> {
     match *s {
-        Surface::Emitter { radiance } if !(radiance >= 0.0 && radiance.is_finite()) => config(
-            format!("shape {name:?}: radiance {radiance} is not a finite number ≥ 0"),
-        ),
-        Surface::Reflector { albedo } if !(0.0..=1.0).contains(&albedo) => {
-            config(format!("shape {name:?}: albedo {albedo} is not in [0, 1]"))
+        Surface::Emitter { radiance } if !(radiance >= 0.0 && radiance.is_finite()) => {
+            config(format!(
+                "shape {name:?}: radiance {} is not a finite number ≥ 0",
+                Num(radiance)
+            ))
         }
+        Surface::Reflector { albedo } if !(0.0..=1.0).contains(&albedo) => config(format!(
+            "shape {name:?}: albedo {} is not in [0, 1]",
+            Num(albedo)
+        )),
         _ => Ok(()),
     }
 }
@@ -181,20 +189,22 @@ fn check_medium(name: &str, m: &Medium) -> Result<(), Error> {
     if !(m.ks >= 0.0 && m.ks.is_finite()) {
         return config(format!(
             "shape {name:?}: κs = {} is not finite and ≥ 0",
-            m.ks
+            Num(m.ks)
         ));
     }
     if !(m.ke >= m.ks && m.ke.is_finite()) {
         return config(format!(
             "shape {name:?}: κe = {} must be finite and ≥ κs = {}",
-            m.ke, m.ks
+            Num(m.ke),
+            Num(m.ks)
         ));
     }
     if let Phase::HenyeyGreenstein { g } = m.phase
         && (g.abs() >= 1.0 || g.is_nan())
     {
         return config(format!(
-            "shape {name:?}: Henyey–Greenstein g = {g} is not in (−1, 1)"
+            "shape {name:?}: Henyey–Greenstein g = {} is not in (−1, 1)",
+            Num(g)
         ));
     }
     Ok(())
@@ -378,7 +388,9 @@ fn check_sensor(
         if seg.distance(p) <= 1e-9 * size {
             return config(format!(
                 "the sensor at [{}, {}] lies on shape {:?}",
-                p.x, p.y, shapes[owner[i] as usize].name
+                Num(p.x),
+                Num(p.y),
+                shapes[owner[i] as usize].name
             ));
         }
     }
@@ -386,7 +398,9 @@ fn check_sensor(
         if s.closed && s.surface.is_opaque() && contains(&s.vertices, p) {
             return config(format!(
                 "the sensor at [{}, {}] is inside the opaque shape {:?}",
-                p.x, p.y, s.name
+                Num(p.x),
+                Num(p.y),
+                s.name
             ));
         }
     }
@@ -402,7 +416,7 @@ fn check_optical_thickness(shapes: &[Shape], size: f64) -> Result<(), Error> {
             return config(format!(
                 "shape {:?}: κe × scene size = {} exceeds {MAX_OPTICAL_THICKNESS}",
                 s.name,
-                m.ke * size
+                Num(m.ke * size)
             ));
         }
         // A path in a medium scatters about min(τs², κs/κa) times before it
