@@ -1,0 +1,247 @@
+//! Adversarial inputs through the binary (issue 11): scene files and CLI
+//! values a hostile or careless user might pass. Each run must end (a hang
+//! guard kills it after [`LIMIT`]), never abort, and either succeed or exit
+//! with status 1 (2 for clap's own parse errors) and a message that names
+//! what is wrong.
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Longest any run here may take: far above what each needs, so only a
+/// hang (or a run that would never end) reaches it.
+const LIMIT: Duration = Duration::from_secs(120);
+
+/// Runs `geosens args`; returns (exit code, stdout, stderr). Panics if the
+/// run is killed by a signal (an abort) or outlives [`LIMIT`].
+fn geosens(args: &[&str]) -> (i32, String, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_geosens"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the geosens binary runs");
+    let start = Instant::now();
+    loop {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        if start.elapsed() > LIMIT {
+            child.kill().ok();
+            panic!("geosens {args:?} did not end within {LIMIT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    let code = out
+        .status
+        .code()
+        .unwrap_or_else(|| panic!("geosens {args:?} was killed: {:?}", out.status));
+    (
+        code,
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Asserts the run failed with `code` and a message holding every `needle`.
+fn refused(args: &[&str], code: i32, needles: &[&str]) {
+    let (c, _, err) = geosens(args);
+    assert_eq!(c, code, "geosens {args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "geosens {args:?}: {err:?} lacks {n:?}");
+    }
+    assert!(err.len() < 600, "geosens {args:?}: message too long: {err}");
+}
+
+/// A scene file in the temp dir with `text`, named uniquely for the test.
+fn scene_file(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("geosens-adversarial-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::File::create(&path)
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    path
+}
+
+/// The occluder scene (lamp at y = 2, occluder at y = 1, sensor at the
+/// origin) scaled by `s`, with `extra` TOML appended.
+fn occluder(s: f64, extra: &str) -> String {
+    format!(
+        "[sensor]\nkind = \"irradiance\"\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\n\
+         [[shapes]]\nname = \"lamp\"\nvertices = [[{a:e}, {b:e}], [{c:e}, {b:e}]]\n\
+         surface = {{ kind = \"emitter\", radiance = 1.0 }}\n\
+         [[shapes]]\nname = \"occ\"\nvertices = [[{d:e}, {e:e}], [{f:e}, {e:e}]]\n\
+         surface = {{ kind = \"absorber\" }}\n\
+         [[parameters]]\nname = \"occ_tx\"\nshape = \"occ\"\nmotion = {{ kind = \"translate_x\" }}\n{extra}",
+        a = -s,
+        b = 2.0 * s,
+        c = s,
+        d = -0.6 * s,
+        e = s,
+        f = 0.2 * s,
+    )
+}
+
+fn flat(path: &std::path::Path, method: &str, paths: &str) -> Vec<String> {
+    vec![
+        "flat".into(),
+        "--scene".into(),
+        path.to_str().unwrap().into(),
+        "--method".into(),
+        method.into(),
+        "--paths".into(),
+        paths.into(),
+        "--json".into(),
+    ]
+}
+
+fn run_flat(path: &std::path::Path, method: &str, paths: &str) -> (i32, String, String) {
+    let args = flat(path, method, paths);
+    geosens(&args.iter().map(String::as_str).collect::<Vec<_>>())
+}
+
+#[test]
+fn scenes_at_extreme_scales_run_or_are_refused_naming_the_size() {
+    // 1e-13 gave I = 0.743 (true 0.2511) and 1e154 gave 0 from every method.
+    for s in [1e-13, 1e13] {
+        let path = scene_file(&format!("scaled{s:e}.toml"), &occluder(s, ""));
+        for method in ["intensity", "rendering", "expectation", "transport"] {
+            let (code, out, err) = run_flat(&path, method, "20000");
+            assert_eq!(code, 0, "{method} at ×{s:e}: {err}");
+            let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+            let i = &v["intensity"];
+            let z = (i["mean"].as_f64().unwrap() - 0.2511).abs() / i["stderr"].as_f64().unwrap();
+            assert!(z < 5.0, "{method} at ×{s:e}: {i}");
+        }
+    }
+    let path = scene_file("huge.toml", &occluder(1e154, ""));
+    let args = flat(&path, "intensity", "100");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(&args, 1, &["size", "rescale"]);
+}
+
+#[test]
+fn a_scene_path_to_an_endless_stream_is_not_read_forever() {
+    let dir = std::env::temp_dir().join(format!("geosens-adversarial-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let link = dir.join("zero.toml");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+    let args = flat(&link, "intensity", "100");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(&args, 1, &["larger than", "zero.toml"]);
+}
+
+#[test]
+fn a_hundred_thousand_shapes_load() {
+    // The name check was quadratic: 24–37 s. Linear now (about a second).
+    let mut text = String::from(
+        "[sensor]\nkind = \"irradiance\"\npoint = [0.0, 0.0]\nnormal = [0.0, 1.0]\n\
+         [[shapes]]\nname = \"lamp\"\nvertices = [[-1.0, 2.0], [1.0, 2.0]]\n\
+         surface = { kind = \"emitter\", radiance = 1.0 }\n",
+    );
+    for i in 0..100_000 {
+        let (x, y) = (
+            -50.0 + (i % 1000) as f64 * 0.1,
+            3.0 + (i / 1000) as f64 * 0.1,
+        );
+        text += &format!(
+            "[[shapes]]\nname = \"s{i}\"\nvertices = [[{x:.4}, {y:.4}], [{:.4}, {y:.4}]]\n\
+             surface = {{ kind = \"absorber\" }}\n",
+            x + 0.05
+        );
+    }
+    let path = scene_file("many.toml", &text);
+    let (code, _, err) = run_flat(&path, "intensity", "1000");
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn media_that_would_never_let_a_path_out_are_refused() {
+    let fog = "[[shapes]]\nname = \"fog\"\nclosed = true\n\
+               vertices = [[-1.5, -0.5], [1.5, -0.5], [1.5, 0.5], [-1.5, 0.5]]\n\
+               surface = { kind = \"transparent\" }\nmedium = { ks = 900.0, ke = 900.0 }\n";
+    let path = scene_file("thick.toml", &occluder(1.0, fog));
+    let args = flat(&path, "intensity", "100");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(&args, 1, &["fog", "scatter", "κs"]);
+}
+
+#[test]
+fn a_peaked_phase_function_is_refused_by_the_expectation_method_only() {
+    let fog = "[[shapes]]\nname = \"fog\"\nclosed = true\n\
+               vertices = [[-1.5, 0.3], [1.5, 0.3], [1.5, 0.6], [-1.5, 0.6]]\n\
+               surface = { kind = \"transparent\" }\n\
+               medium = { ks = 1.0, ke = 1.2, phase = { kind = \"henyey_greenstein\", g = 0.99999999 } }\n";
+    let path = scene_file("peaked.toml", &occluder(1.0, fog));
+    let args = flat(&path, "expectation", "100");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(
+        &args,
+        1,
+        &["fog", "g = 0.99999999", "rendering or transport"],
+    );
+    for method in ["rendering", "transport", "intensity"] {
+        let (code, _, err) = run_flat(&path, method, "2000");
+        assert_eq!(code, 0, "{method}: {err}");
+    }
+}
+
+#[test]
+fn numbers_in_messages_are_short_and_flags_name_themselves() {
+    refused(
+        &[
+            "rod",
+            "--method",
+            "intensity",
+            "--ks",
+            "1",
+            "--ke",
+            "2",
+            "--length",
+            "2",
+            "--x",
+            "3e300",
+            "--omega",
+            "1",
+        ],
+        1,
+        &["x = 3e300"],
+    );
+    let path = scene_file("ok.toml", &occluder(1.0, ""));
+    let p = path.to_str().unwrap();
+    refused(
+        &[
+            "flat",
+            "--scene",
+            p,
+            "--method",
+            "intensity",
+            "--paths",
+            "-5",
+        ],
+        2,
+        &["--paths", "-5"],
+    );
+    refused(
+        &[
+            "flat",
+            "--scene",
+            p,
+            "--method",
+            "intensity",
+            "--threads",
+            "-1",
+        ],
+        2,
+        &["--threads"],
+    );
+    // A normal of [1e308, 1e308] has a direction (its length overflows).
+    let big = occluder(1.0, "").replace("normal = [0.0, 1.0]", "normal = [1e308, 1e308]");
+    let path = scene_file("big_normal.toml", &big);
+    let (code, _, err) = run_flat(&path, "intensity", "1000");
+    assert_eq!(code, 0, "{err}");
+}
