@@ -61,6 +61,14 @@ pub trait Estimator: Sync {
     /// into `weights` (of length `self.quantities().len()`).
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]);
 
+    /// Warnings about particular quantities, found when the estimator was
+    /// built (finite differences whose two displaced problems differ in the
+    /// sensor's view, say): their estimates may be far off whatever their
+    /// error bars say, and are reported unreliable. None by default.
+    fn caveats(&self) -> Vec<(Quantity, String)> {
+        Vec::new()
+    }
+
     /// Samples `paths` paths and adds their weights to `sums` (one
     /// accumulator per quantity). This provided loop is compiled once per
     /// estimator, so even through `dyn Estimator` the runner pays one

@@ -74,6 +74,7 @@ pub struct Pair {
 pub struct CentralDifference {
     nominal: Option<Box<dyn Estimator>>,
     pairs: Vec<Pair>,
+    caveats: Vec<(Quantity, String)>,
 }
 
 /// The only quantity a run of a [`CentralDifference`] may estimate.
@@ -115,7 +116,18 @@ impl CentralDifference {
                 )));
             }
         }
-        Ok(CentralDifference { nominal, pairs })
+        Ok(CentralDifference {
+            nominal,
+            pairs,
+            caveats: Vec::new(),
+        })
+    }
+
+    /// The same with a warning on `parameter`'s quantity (see
+    /// [`Estimator::caveats`]).
+    pub fn with_caveat(mut self, parameter: &str, why: String) -> Self {
+        self.caveats.push((Quantity::sensitivity(parameter), why));
+        self
     }
 }
 
@@ -147,6 +159,10 @@ impl Estimator for CentralDifference {
                     .map(|p| Quantity::sensitivity(&p.parameter)),
             )
             .collect()
+    }
+
+    fn caveats(&self) -> Vec<(Quantity, String)> {
+        self.caveats.clone()
     }
 
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {

@@ -8,7 +8,7 @@ use geosens::flat::figures::stability;
 use geosens::flat::space::Plane;
 use geosens::flat::{Method, Motion, Parameter, Scene, Sensor, Shape, Surface};
 use geosens::path::intensity::PlainEstimator;
-use geosens::{Quantity, RunConfig, run};
+use geosens::{Estimator, Quantity, RunConfig, run};
 use glam::DVec2;
 use std::sync::Arc;
 
@@ -291,4 +291,57 @@ fn a_thick_conservative_fog_does_not_collapse_to_zero() {
     assert!(nee.stderr < 0.05 * nee.mean, "{nee:?}");
     let z = (nee.mean - plain.mean).abs() / nee.stderr.hypot(plain.stderr);
     assert!(z < 4.0, "NEE {nee:?} vs plain {plain:?}");
+}
+
+#[test]
+fn finite_differences_warn_when_the_step_changes_what_the_sensor_sees() {
+    // An occluder's corner 10⁻⁴ above the sensor: the default half step
+    // (10⁻³ × size) carries it past the sensor's zenith both ways, and the
+    // quotient gave −223.5 ± 0.3 for an exact −10⁴, reported reliable.
+    let scene = Arc::new(
+        Scene::new(
+            vec![
+                segment(
+                    "lamp",
+                    [-1.0, 2.0],
+                    [1.0, 2.0],
+                    Surface::Emitter { radiance: 1.0 },
+                ),
+                segment("occ", [-0.6, 1e-4], [0.0, 1e-4], Surface::Absorber),
+            ],
+            vec![parameter("occ_tx", "occ", Motion::TranslateX)],
+            irradiance_up(),
+        )
+        .unwrap(),
+    );
+    let exact = Reference::for_scene(&scene).unwrap().derivative(0);
+    let coarse = Method::Fd.estimator(scene.clone()).unwrap();
+    let caveats = coarse.caveats();
+    assert_eq!(caveats.len(), 1, "{caveats:?}");
+    assert!(caveats[0].1.contains("occ_tx"), "{caveats:?}");
+    // A step well inside the corner's height sees one view both ways, and
+    // the quotient the closed form.
+    let fine = geosens::flat::methods::finite_difference(&scene, 1e-6).unwrap();
+    assert!(fine.caveats().is_empty(), "{:?}", fine.caveats());
+    let r = run(&fine, &RunConfig::new(200_000, 3).unwrap()).unwrap();
+    let s = r.get(&Quantity::sensitivity("occ_tx")).unwrap();
+    assert!(s.z_score(exact) < 4.0, "{s:?} vs {exact}");
+}
+
+#[test]
+fn the_shipped_scenes_raise_no_finite_difference_caveat() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let scene = Arc::new(geosens::flat::file::load(&path).unwrap());
+            let fd = Method::Fd.estimator(scene).unwrap();
+            assert!(
+                fd.caveats().is_empty(),
+                "{}: {:?}",
+                path.display(),
+                fd.caveats()
+            );
+        }
+    }
 }

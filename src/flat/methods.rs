@@ -124,21 +124,111 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
                 ),
                 _ => (step, String::new()),
             };
-            let displaced = |delta: f64| -> Result<Box<dyn Estimator>, Error> {
-                let moved = scene
+            let displaced = |delta: f64| -> Result<Arc<Scene>, Error> {
+                scene
                     .displaced(j, delta)
-                    .map_err(|e| invalid_displacement("scene", &p.name, delta, &note, e))?;
-                Method::Intensity.estimator(Arc::new(moved))
+                    .map(Arc::new)
+                    .map_err(|e| invalid_displacement("scene", &p.name, delta, &note, e))
             };
-            Ok(Pair {
-                parameter: p.name.clone(),
-                plus: displaced(h)?,
-                minus: displaced(-h)?,
-                half_step: h,
-            })
+            let (plus, minus) = (displaced(h)?, displaced(-h)?);
+            let caveat = view_change(scene, j, h, &plus, &minus);
+            Ok((
+                Pair {
+                    parameter: p.name.clone(),
+                    plus: Method::Intensity.estimator(plus)?,
+                    minus: Method::Intensity.estimator(minus)?,
+                    half_step: h,
+                },
+                caveat,
+            ))
         })
-        .collect::<Result<_, Error>>()?;
-    CentralDifference::new(Some(Method::Intensity.estimator(Arc::clone(scene))?), pairs)
+        .collect::<Result<Vec<_>, Error>>()?;
+    let mut caveats = Vec::new();
+    let pairs = pairs
+        .into_iter()
+        .map(|(pair, caveat)| {
+            if let Some(c) = caveat {
+                caveats.push((pair.parameter.clone(), c));
+            }
+            pair
+        })
+        .collect();
+    let mut fd =
+        CentralDifference::new(Some(Method::Intensity.estimator(Arc::clone(scene))?), pairs)?;
+    for (parameter, why) in caveats {
+        fd = fd.with_caveat(&parameter, why);
+    }
+    Ok(fd)
+}
+
+/// Why the central difference along parameter `j` (half step `h`) may not
+/// estimate the derivative, if it may not: the moved shape passes the
+/// sensor within the step, or the sensor's view (the visible corners in
+/// angular order, or what a radiance sensor's ray hits first) differs
+/// between the two displaced scenes: the quotient then straddles a change of
+/// visibility, and its error bar cannot see it.
+fn view_change(scene: &Scene, j: usize, h: f64, plus: &Scene, minus: &Scene) -> Option<String> {
+    let name = &scene.parameters()[j].name;
+    let k = scene.parameter_shape(j) as usize;
+    let shape = &scene.shapes()[k];
+    let x = scene.sensor().point();
+    let motion = scene.parameters()[j].motion;
+    let travel = shape
+        .vertices
+        .iter()
+        .map(|&q| (motion.apply(q, h) - q).length())
+        .fold(0.0, f64::max);
+    let distance = shape
+        .segments()
+        .map(|s| s.distance(x))
+        .fold(f64::INFINITY, f64::min);
+    if travel >= 0.5 * distance {
+        return Some(format!(
+            "finite differences along {name:?}: the step moves shape {:?} by {} while it \
+             passes {} from the sensor; try a smaller --fd-step",
+            shape.name,
+            crate::error::Num(travel),
+            crate::error::Num(distance)
+        ));
+    }
+    (sensor_view(plus) != sensor_view(minus)).then(|| {
+        format!(
+            "finite differences along {name:?}: the sensor's view (visible corners, their \
+             order) differs between the scenes displaced by ±{}: the difference straddles a \
+             change of visibility; try a smaller --fd-step",
+            crate::error::Num(h)
+        )
+    })
+}
+
+/// What the sensor sees, up to continuous motion: the corners visible from
+/// an irradiance sensor in front of it, in angular order; the shape a
+/// radiance sensor's ray meets first.
+fn sensor_view(scene: &Scene) -> Vec<u32> {
+    use super::Sensor;
+    use super::geometry::NO_SEGMENT;
+    match scene.sensor() {
+        Sensor::Irradiance { point, normal } => {
+            let mut seen: Vec<(f64, u32)> = scene
+                .corners()
+                .iter()
+                .enumerate()
+                .filter(|(_, (q, _))| (*q - point).dot(normal) > 0.0)
+                .filter(|(_, (q, _))| scene.visible(point, *q, NO_SEGMENT))
+                .map(|(i, (q, _))| {
+                    let r = *q - point;
+                    (r.y.atan2(r.x), i as u32)
+                })
+                .collect();
+            seen.sort_by(|a, b| a.0.total_cmp(&b.0));
+            seen.into_iter().map(|s| s.1).collect()
+        }
+        Sensor::Radiance { point, direction } => scene
+            .opaque_hit(point, direction, NO_SEGMENT)
+            .map(|h| h.2)
+            .into_iter()
+            .collect(),
+    }
 }
 
 /// The expectation method's warp field at the sensor: `V_j(φ)` (rad per
