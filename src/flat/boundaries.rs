@@ -59,6 +59,7 @@ impl Boundaries for Plane {
         })
     }
 
+    // ANCHOR: sides
     /// The segments at the corner that lie on either side of the sight line
     /// `ω` from `x`; on each side the ray just past the line meets the one
     /// whose direction `d` from the corner has the least `(d·ω)/|ω × d|`
@@ -91,6 +92,7 @@ impl Boundaries for Plane {
         (ccw.1, cw.1)
     }
 
+    // ANCHOR_END: sides
     #[inline]
     fn boundary_normal(&self, x: DVec2, b: &BoundaryPoint<DVec2>) -> DVec2 {
         perp((b.q - x).normalize())
@@ -115,6 +117,7 @@ impl Boundaries for Plane {
         }
     }
 
+    // ANCHOR: warp_velocity
     #[inline]
     fn warp_velocity(
         &self,
@@ -142,6 +145,7 @@ impl Boundaries for Plane {
         let slope = (vb - va) / (da + db);
         (perp(w) * (va + slope * da), slope)
     }
+    // ANCHOR_END: warp_velocity
 }
 
 impl Plane {
