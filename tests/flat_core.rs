@@ -345,3 +345,63 @@ fn the_shipped_scenes_raise_no_finite_difference_caveat() {
         }
     }
 }
+
+#[test]
+fn a_reflectors_concave_corner_lights_itself() {
+    // The sensor looks into an asymmetric V-shaped reflector: the corner's
+    // two faces see each other near it. Rendering and transport evaluate the
+    // corner's jump with paths leaving each face there; expectation has no
+    // jump term at all (its warp follows the corner), so it is an
+    // independent reference.
+    let vee = Shape {
+        name: "vee".into(),
+        vertices: vec![
+            DVec2::new(-1.0, 1.9),
+            DVec2::new(0.0, 1.0),
+            DVec2::new(1.0, 1.4),
+        ],
+        closed: false,
+        surface: Surface::Reflector { albedo: 0.9 },
+        medium: None,
+    };
+    let scene = Arc::new(
+        Scene::new(
+            vec![
+                segment(
+                    "lamp",
+                    [-2.0, 3.0],
+                    [0.5, 3.0],
+                    Surface::Emitter { radiance: 1.0 },
+                ),
+                vee,
+            ],
+            vec![
+                parameter("vee_tx", "vee", Motion::TranslateX),
+                parameter(
+                    "vee_rot",
+                    "vee",
+                    Motion::Rotate {
+                        pivot: Some(DVec2::new(0.3, 1.2)),
+                    },
+                ),
+            ],
+            Sensor::Irradiance {
+                point: DVec2::new(0.25, 1.5),
+                normal: -DVec2::Y,
+            },
+        )
+        .unwrap(),
+    );
+    let cfg = RunConfig::new(1_000_000, 5).unwrap();
+    let get = |m: Method| {
+        let r = run(m.estimator(scene.clone()).unwrap().as_ref(), &cfg).unwrap();
+        ["vee_tx", "vee_rot"].map(|p| r.get(&Quantity::sensitivity(p)).unwrap())
+    };
+    let reference = get(Method::Expectation);
+    for m in [Method::Rendering, Method::Transport] {
+        for (s, e) in get(m).iter().zip(&reference) {
+            let z = (s.mean - e.mean).abs() / s.stderr.hypot(e.stderr);
+            assert!(z < 4.0, "{}: {s:?} vs expectation {e:?}", m.name());
+        }
+    }
+}

@@ -117,6 +117,19 @@ impl Boundaries for Plane {
         }
     }
 
+    #[inline]
+    fn off_boundary(&self, b: &BoundaryPoint<DVec2>, p: u32) -> DVec2 {
+        let seg = self.scene.segments()[p as usize];
+        let other = if (seg.a - b.q).length_squared() < (seg.b - b.q).length_squared() {
+            seg.b
+        } else {
+            seg.a
+        };
+        let along = other - b.q;
+        let step = (1e-9 * self.scene.size()).min(0.5 * along.length());
+        b.q + along.normalize() * step
+    }
+
     // ANCHOR: warp_velocity
     #[inline]
     fn warp_velocity(

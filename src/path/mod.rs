@@ -271,6 +271,11 @@ pub trait Boundaries: Geometry {
     /// from `x` to the boundary point), normal to the boundary there and
     /// pointing to the side [`Boundaries::sides`] names first.
     fn boundary_normal(&self, x: Self::V, b: &BoundaryPoint<Self::V>) -> Self::V;
+    /// A point of primitive `p` a hair (10⁻⁹ of the scene's size) from the
+    /// boundary point, where a path leaving `p`'s surface "at" the boundary
+    /// starts: at the point itself its rays would slip past the
+    /// neighbouring faces (a reflector's concave corner lights itself).
+    fn off_boundary(&self, b: &BoundaryPoint<Self::V>, p: Prim) -> Self::V;
 
     /// The expectation method's warp of the directions at a vertex: a
     /// continuous velocity field over directions that equals each

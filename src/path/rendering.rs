@@ -190,7 +190,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     }
     let (ahead, behind) = g.sides(v.x, &b);
     let side = |rng: &mut PathRng, side: Side| match side {
-        Side::Surface(p) => surface_radiance(g, rng, b.q, p, wq, medium),
+        Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(&b, p), p, wq, medium),
         Side::Past => radiance(g, rng, b.q, wq, medium, NO_PRIM),
     };
     // Common random numbers for the two sides: where both see a surface
