@@ -212,6 +212,42 @@ impl<V: Vector> Deform<V> {
     }
     // ANCHOR_END: boundary_speed
 
+    /// [`Deform::boundary_speed`] for the segment from `x` along `w` ending
+    /// at `hit` (slots moving the hit shape per `slots`, none when
+    /// `frozen`); every `ṫ_b` is 0 when the segment escapes.
+    #[inline]
+    pub fn segment<G: Geometry<V = V>>(
+        &mut self,
+        g: &G,
+        slots: &Slots,
+        frozen: bool,
+        x: V,
+        w: V,
+        hit: Option<Hit>,
+    ) {
+        match hit {
+            Some(h) => {
+                let moving = if frozen {
+                    SlotSet::EMPTY
+                } else {
+                    slots.moving(g.shape(h.prim))
+                };
+                self.boundary_speed(g, h, x, w, moving);
+            }
+            None => self.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
+        }
+    }
+
+    /// A fixed free path `ξ`: every live slot's vertex moves with its
+    /// turning direction only, `u += ξ ω̇`.
+    #[inline]
+    pub fn carry(&mut self, xi: f64) {
+        for j in self.live.iter() {
+            let s = &mut self.slots[j];
+            s.u = s.u + s.wd * xi;
+        }
+    }
+
     /// Moves the vertex of every slot in `rule` onto the boundary at
     /// distance `t` along `w`: `u += ṫ_b ω + t ω̇`.
     #[inline]
@@ -364,14 +400,7 @@ struct Follow<'a, V: Vector> {
 impl<G: Geometry> Hooks<G> for Follow<'_, G::V> {
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
-        if let Some(h) = hit {
-            let moving = if self.frozen {
-                SlotSet::EMPTY
-            } else {
-                self.slots.moving(g.shape(h.prim))
-            };
-            self.d.boundary_speed(g, h, x, w, moving);
-        }
+        self.d.segment(g, self.slots, self.frozen, x, w, hit);
     }
     #[inline]
     fn pass(&mut self, ke: f64) {

@@ -62,13 +62,7 @@ fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>
 impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
-        match hit {
-            Some(h) => {
-                let moving = self.slots.moving(g.shape(h.prim));
-                self.d.boundary_speed(g, h, x, w, moving);
-            }
-            None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
-        }
+        self.d.segment(g, self.slots, false, x, w, hit);
     }
     // ANCHOR: collision
     #[inline]

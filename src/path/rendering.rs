@@ -212,13 +212,7 @@ pub(super) fn corner_jump<G: Boundaries>(
 impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
-        match hit {
-            Some(h) => {
-                let moving = movers(self.slots, g.shape(h.prim), self.frozen);
-                self.d.boundary_speed(g, h, x, w, moving);
-            }
-            None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
-        }
+        self.d.segment(g, self.slots, self.frozen, x, w, hit);
     }
     #[inline]
     fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
@@ -226,11 +220,7 @@ impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
     }
     #[inline]
     fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
-        // Fixed free path: the vertex moves with the turning direction only.
-        for j in self.d.live.iter() {
-            let s = &mut self.d.slots[j];
-            s.u = s.u + s.wd * xi;
-        }
+        self.d.carry(xi);
     }
     #[inline]
     fn pass(&mut self, ke: f64) {
@@ -246,28 +236,57 @@ impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
     }
     #[inline]
     fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
-        let (slots, frozen) = (self.slots, self.frozen);
-        let turning = frame_spins(g, slots, &mut self.d, v, frozen);
-        connect(
+        attached_connect(
             g,
-            slots,
+            self.slots,
             self.scratch,
             &mut self.d,
             rng,
             v,
-            frozen,
-            |d, w| attach(d, slots.all(), turning, w),
+            self.frozen,
         )
     }
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
-        if self.slots.is_empty() {
-            return v.lobe.sample(rng);
-        }
-        let turning = frame_spins(g, self.slots, &mut self.d, v, self.frozen);
-        corner_jump(g, self.slots, &mut self.d, rng, v, turning, self.frozen);
-        let w = v.lobe.sample(rng);
-        attach(&mut self.d, self.slots.all(), turning, w);
-        w
+        attached_scatter(g, self.slots, &mut self.d, rng, v, self.frozen)
     }
+}
+
+/// Next-event estimation with the connection's direction attached to the
+/// vertex's frame (rendering's rule; transport's too).
+#[inline]
+pub(super) fn attached_connect<G: Boundaries>(
+    g: &G,
+    slots: &Slots,
+    scratch: &mut Scratch<G::V>,
+    d: &mut Deform<G::V>,
+    rng: &mut PathRng,
+    v: &Vertex<G>,
+    frozen: bool,
+) -> f64 {
+    let turning = frame_spins(g, slots, d, v, frozen);
+    connect(g, slots, scratch, d, rng, v, frozen, |d, w| {
+        attach(d, slots.all(), turning, w)
+    })
+}
+
+/// The direction leaving `v`, attached to its frame, after the boundary
+/// term of its directional integral ([`corner_jump`]).
+#[inline]
+pub(super) fn attached_scatter<G: Boundaries>(
+    g: &G,
+    slots: &Slots,
+    d: &mut Deform<G::V>,
+    rng: &mut PathRng,
+    v: &Vertex<G>,
+    frozen: bool,
+) -> G::V {
+    if slots.is_empty() {
+        return v.lobe.sample(rng);
+    }
+    let turning = frame_spins(g, slots, d, v, frozen);
+    corner_jump(g, slots, d, rng, v, turning, frozen);
+    let w = v.lobe.sample(rng);
+    attach(d, slots.all(), turning, w);
+    w
 }

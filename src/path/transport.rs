@@ -16,8 +16,8 @@
 //! The sensor-position slots (`∂I/∂x`, …) follow rendering's rules.
 //! Book: chapter "Flatland: one deformation, three estimators", section
 //! "Transport".
-use super::deform::{Deform, Scratch, Slots, connect};
-use super::rendering::{Rendering, attach, corner_jump, frame_spins, leibniz};
+use super::deform::{Deform, Scratch, Slots};
+use super::rendering::{Rendering, attached_connect, attached_scatter, leibniz};
 use super::walk::{Hooks, Leg, Vertex, radiance, walk};
 use super::{Boundaries, Geometry, Hit, MediumId, NO_PRIM, Vector};
 use crate::rng::PathRng;
@@ -115,13 +115,7 @@ impl<G: Boundaries> Transport<'_, G> {
 impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
-        match hit {
-            Some(h) => {
-                let moving = self.slots.moving(g.shape(h.prim));
-                self.d.boundary_speed(g, h, x, w, moving);
-            }
-            None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
-        }
+        self.d.segment(g, self.slots, false, x, w, hit);
     }
     #[inline]
     fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
@@ -129,10 +123,7 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     }
     #[inline]
     fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
-        for j in self.d.live.iter() {
-            let s = &mut self.d.slots[j];
-            s.u = s.u + s.wd * xi;
-        }
+        self.d.carry(xi);
     }
     #[inline]
     fn pass(&mut self, ke: f64) {
@@ -206,29 +197,11 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     }
     #[inline]
     fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
-        let slots = self.slots;
-        let turning = frame_spins(g, slots, &mut self.d, v, false);
-        connect(
-            g,
-            slots,
-            self.scratch,
-            &mut self.d,
-            rng,
-            v,
-            false,
-            |d, w| attach(d, slots.all(), turning, w),
-        )
+        attached_connect(g, self.slots, self.scratch, &mut self.d, rng, v, false)
     }
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
-        if self.slots.is_empty() {
-            return super::Lobe::sample(&v.lobe, rng);
-        }
-        let turning = frame_spins(g, self.slots, &mut self.d, v, false);
-        corner_jump(g, self.slots, &mut self.d, rng, v, turning, false);
-        let w = super::Lobe::sample(&v.lobe, rng);
-        attach(&mut self.d, self.slots.all(), turning, w);
-        w
+        attached_scatter(g, self.slots, &mut self.d, rng, v, false)
     }
     #[inline]
     fn reflected(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>, w: G::V) {
