@@ -417,7 +417,7 @@ fn emitter_points_are_uniform_by_length() {
     let mut h = Histogram::new(0.0, total, 120);
     let mut rng = stream(600, 0);
     for _ in 0..N {
-        let (y, p) = plane.emitter_point(rng.random()).unwrap();
+        let (y, p) = plane.emitter_point(&mut rng).unwrap();
         let k = lit
             .iter()
             .position(|&(i, _)| i == p)
@@ -469,7 +469,7 @@ fn emitter_directions_follow_the_light_pdf() {
         let mut h = Histogram::new(-PI, PI, 720);
         let mut rng = stream(700 + i as u64, 0);
         for _ in 0..N {
-            let (y, _) = plane.emitter_point(rng.random()).unwrap();
+            let (y, _) = plane.emitter_point(&mut rng).unwrap();
             h.add((y - x).y.atan2((y - x).x));
         }
         let expected = h.expected(N, &pdf, &ends);

@@ -8,7 +8,9 @@ use super::geometry::{NO_SEGMENT, cross};
 use super::lobe::FlatLobe;
 use super::scene::{Phase, Scene, Sensor as FlatSensor};
 use crate::path::{Geometry, Hit, MediumId, Prim, Sensor, Surface};
+use crate::rng::PathRng;
 use glam::DVec2;
+use rand::RngExt;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -187,8 +189,8 @@ impl Geometry for Plane {
         }
     }
     #[inline]
-    fn emitter_point(&self, u: f64) -> Option<(DVec2, Prim)> {
-        self.scene.emitter_point(u)
+    fn emitter_point(&self, rng: &mut PathRng) -> Option<(DVec2, Prim)> {
+        self.scene.emitter_point(rng.random())
     }
     /// `r / (|cos θ_e| L)` for a point drawn by length on emitters of total
     /// length `L`.

@@ -214,9 +214,10 @@ pub trait Geometry: Sync {
     fn cosine_lobe(&self, n: Self::V, c: f64) -> Self::Lobe;
     /// The phase function of medium `m` about the incoming direction `w`.
     fn phase_lobe(&self, m: MediumId, w: Self::V) -> Self::Lobe;
-    /// A point drawn on the emitters from a uniform `u`: the point and its
-    /// primitive; `None` without emitters.
-    fn emitter_point(&self, u: f64) -> Option<(Self::V, Prim)>;
+    /// A point drawn on the emitters (by length in the plane, by area in
+    /// space: as many uniform numbers as the geometry needs): the point and
+    /// its primitive; `None` without emitters.
+    fn emitter_point(&self, rng: &mut PathRng) -> Option<(Self::V, Prim)>;
     /// The density over directions at `x` of drawing the emitter point `y`
     /// of primitive `p` with [`Geometry::emitter_point`].
     fn light_pdf(&self, x: Self::V, y: Self::V, p: Prim) -> f64;

@@ -183,7 +183,7 @@ pub fn light_sample<G: Geometry>(
     rng: &mut PathRng,
     v: &Vertex<G>,
 ) -> Option<(G::V, Prim, f64)> {
-    let (y, p) = g.emitter_point(rng.random())?;
+    let (y, p) = g.emitter_point(rng)?;
     let d = y - v.x;
     let w = d * (1.0 / d.length());
     let (f, p_light) = (v.lobe.pdf(w), g.light_pdf(v.x, y, p));
