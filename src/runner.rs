@@ -3,6 +3,13 @@
 //! run on a rayon pool, their moments are collected in chunk order and merged
 //! serially. The result is therefore bit-identical for any thread count
 //! (rayon's own float reductions are not: rayon-rs/rayon#663).
+//!
+//! Chunks run in batches of [`BATCH`]: a batch's moments are collected,
+//! merged into the running total in chunk order, and dropped before the next
+//! batch starts. Memory is one batch's moments whatever the path count, and
+//! the merge order (every chunk in turn, from the first) is the one a single
+//! serial fold over all chunks would follow, so the batch size changes no
+//! bit of the result.
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::rng;
@@ -13,6 +20,19 @@ use std::time::Instant;
 
 /// Paths per chunk. Part of what a seed means: changing it changes results.
 pub const CHUNK: u64 = 4096;
+
+/// Chunks per batch (4.2 million paths): enough to keep every core busy
+/// between the batch's merges (a core idles at most one chunk per batch),
+/// few enough that a batch's moments stay small (64 bytes per quantity and
+/// chunk: 256 KiB for the rod's 4 quantities, 17 MB for a scene with 253
+/// parameters). Not part of what a seed means: any batch size gives the
+/// same bits.
+pub const BATCH: u64 = 1024;
+
+/// Most paths a run may sample: 2⁵³, the largest count below which every
+/// count is exact as an `f64` (the moments' merge weighs chunks by their
+/// counts in `f64`). At 10⁸ paths a second it would take three years.
+pub const MAX_PATHS: u64 = 1 << 53;
 
 /// How many paths to sample, from which seed, on how many threads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -26,15 +46,10 @@ pub struct RunConfig {
 }
 
 impl RunConfig {
-    /// A configuration on all cores; errors if `paths < 2`.
+    /// A configuration on all cores; errors if `paths < 2` or
+    /// `paths > MAX_PATHS`.
     pub fn new(paths: u64, seed: u64) -> Result<RunConfig, Error> {
-        if paths < 2 {
-            return Err(Error::InvalidParameter {
-                name: "paths",
-                value: paths as f64,
-                expected: "at least 2 (an error bar needs two samples)",
-            });
-        }
+        check_paths(paths)?;
         Ok(RunConfig {
             paths,
             seed,
@@ -70,6 +85,25 @@ impl RunResult {
     }
 }
 
+/// Errors unless `2 ≤ paths ≤ MAX_PATHS`.
+fn check_paths(paths: u64) -> Result<(), Error> {
+    if paths < 2 {
+        return Err(Error::InvalidParameter {
+            name: "paths",
+            value: paths as f64,
+            expected: "at least 2 (an error bar needs two samples)",
+        });
+    }
+    if paths > MAX_PATHS {
+        // The exact count: as an f64 it would print other digits.
+        return Err(Error::Config(format!(
+            "paths = {paths}: expected at most 2^53 = {MAX_PATHS} \
+             (a path count must be exact as an f64)"
+        )));
+    }
+    Ok(())
+}
+
 /// Moments of every quantity over chunk `c`.
 fn run_chunk<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig, nq: usize, c: u64) -> Vec<Moments> {
     let mut rng = rng::stream(cfg.seed, c);
@@ -79,50 +113,64 @@ fn run_chunk<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig, nq: usize, c: u64)
     sums.iter().map(ChunkSums::moments).collect()
 }
 
-/// Samples `cfg.paths` paths of `est` and returns its estimates.
-pub fn run<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig) -> Result<RunResult, Error> {
-    if cfg.paths < 2 {
-        return Err(Error::InvalidParameter {
-            name: "paths",
-            value: cfg.paths as f64,
-            expected: "at least 2 (an error bar needs two samples)",
-        });
-    }
-    let quantities = est.quantities();
-    let nq = quantities.len();
-    let chunks = cfg.paths.div_ceil(CHUNK);
-    let per_chunk: Vec<Vec<Moments>>;
-    let start;
-    if cfg.threads == 1 {
-        // One thread: no pool to build (a thread spawn per call), same chunks
-        // in the same order, so the same bits.
-        start = Instant::now();
-        per_chunk = (0..chunks).map(|c| run_chunk(est, cfg, nq, c)).collect();
-    } else if cfg.threads == 0 {
-        // All cores: rayon's global pool, built once per process.
-        start = Instant::now();
-        per_chunk = (0..chunks)
+/// Merges the moments of chunks `chunks` into `total`, in chunk order; the
+/// chunks run in parallel on the current rayon pool unless `serial`.
+fn run_batch<E: Estimator + ?Sized>(
+    est: &E,
+    cfg: &RunConfig,
+    chunks: std::ops::Range<u64>,
+    serial: bool,
+    total: &mut [Moments],
+) {
+    let nq = total.len();
+    let per_chunk: Vec<Vec<Moments>> = if serial {
+        chunks.map(|c| run_chunk(est, cfg, nq, c)).collect()
+    } else {
+        chunks
             .into_par_iter()
             .map(|c| run_chunk(est, cfg, nq, c))
-            .collect();
+            .collect()
+    };
+    for chunk in &per_chunk {
+        for (t, m) in total.iter_mut().zip(chunk) {
+            *t = t.merge(m);
+        }
+    }
+}
+
+/// Samples `cfg.paths` paths of `est` and returns its estimates.
+///
+/// Memory does not grow with `cfg.paths` (chunks run in batches of
+/// [`BATCH`]); a run of [`MAX_PATHS`] starts like any other and runs until
+/// interrupted.
+pub fn run<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig) -> Result<RunResult, Error> {
+    check_paths(cfg.paths)?;
+    let quantities = est.quantities();
+    let mut total = vec![Moments::default(); quantities.len()];
+    let chunks = cfg.paths.div_ceil(CHUNK);
+    let batches = |total: &mut [Moments]| {
+        let mut first = 0;
+        while first < chunks {
+            let last = chunks.min(first + BATCH);
+            // One thread: no pool to build (a thread spawn per call), same
+            // chunks in the same order, so the same bits.
+            run_batch(est, cfg, first..last, cfg.threads == 1, total);
+            first = last;
+        }
+    };
+    let start;
+    if cfg.threads <= 1 {
+        // One thread, or all cores on rayon's global pool (built once per
+        // process).
+        start = Instant::now();
+        batches(&mut total);
     } else {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(cfg.threads)
             .build()
             .map_err(|e| Error::Config(format!("cannot start {} threads: {e}", cfg.threads)))?;
         start = Instant::now();
-        per_chunk = pool.install(|| {
-            (0..chunks)
-                .into_par_iter()
-                .map(|c| run_chunk(est, cfg, nq, c))
-                .collect()
-        });
-    }
-    let mut total = vec![Moments::default(); nq];
-    for chunk in &per_chunk {
-        for (t, m) in total.iter_mut().zip(chunk) {
-            *t = t.merge(m);
-        }
+        pool.install(|| batches(&mut total));
     }
     let seconds = start.elapsed().as_secs_f64();
     Ok(RunResult {

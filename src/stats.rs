@@ -10,11 +10,19 @@
 //! - the *largest weight's share* `max|w| / Σ|w|`: a share near 1 means one
 //!   path made the estimate.
 //!
+//! - the *count of non-zero weights*: below [`Estimate::MIN_NONZERO`] the
+//!   sample variance rests on too few values to mean anything (at 0 it is
+//!   `0 ± 0` whatever the truth).
+//!
 //! Neither can see what was never sampled: a weight of huge size and tiny
 //! probability that no path hit leaves a small, wrong error bar and clean
 //! diagnostics (the stability map of the book's chapter "Comparing the
 //! approaches" shows where this happens).
-use serde::Serialize;
+//!
+//! Overflow is never hidden: power sums that overflow give a NaN or infinite
+//! moment, hence a non-finite standard error or VOV and an unreliable
+//! estimate, not a clamped 0.
+use serde::ser::{Serialize, SerializeStruct, Serializer};
 
 /// Hot-loop accumulator over one chunk: power sums of the weights shifted by
 /// the chunk's first weight (no division per sample, and the shift keeps the
@@ -80,14 +88,23 @@ impl ChunkSums {
         let m2 = m * m;
         Moments {
             n: total,
+            nonzero: self.n,
             mean: self.shift + m,
-            m2: (s2 - n * m2).max(0.0),
+            m2: rounding_floor(s2 - n * m2),
             m3: s3 - 3.0 * m * s2 + 2.0 * n * m2 * m,
-            m4: (s4 - 4.0 * m * s3 + 6.0 * m2 * s2 - 3.0 * n * m2 * m2).max(0.0),
+            m4: rounding_floor(s4 - 4.0 * m * s3 + 6.0 * m2 * s2 - 3.0 * n * m2 * m2),
             max_abs: self.max_abs,
             sum_abs: self.sum_abs,
         }
     }
+}
+
+/// An even central moment, whose rounding may leave it slightly below 0,
+/// clamped at 0; NaN and ±∞ (overflowed power sums) pass through, unlike
+/// `f64::max`, which would turn NaN into 0.
+#[inline]
+fn rounding_floor(v: f64) -> f64 {
+    if v < 0.0 { 0.0 } else { v }
 }
 
 /// Count, mean and central moment sums `Mk = Σ(w − w̄)^k`, k = 2..4, of a set
@@ -98,6 +115,8 @@ impl ChunkSums {
 pub struct Moments {
     /// Number of weights.
     pub n: u64,
+    /// Number of non-zero weights among them.
+    pub nonzero: u64,
     /// Their mean.
     pub mean: f64,
     /// Σ(w − w̄)².
@@ -134,6 +153,7 @@ impl Moments {
         let d2 = d * d;
         Moments {
             n: self.n + other.n,
+            nonzero: self.nonzero + other.nonzero,
             mean: self.mean + d * nb / n,
             m2: self.m2 + other.m2 + d2 * na * nb / n,
             m3: self.m3
@@ -150,12 +170,23 @@ impl Moments {
         }
     }
 
-    /// The user-facing estimate of the mean.
+    /// The user-facing estimate of the mean. Non-finite moments (overflowed
+    /// power sums) give a non-finite standard error and VOV.
     pub fn estimate(&self) -> Estimate {
         let n = self.n as f64;
         let variance = if self.n > 1 { self.m2 / (n - 1.0) } else { 0.0 };
-        let vov = if self.m2 > 0.0 {
-            (self.m4 / (self.m2 * self.m2) - 1.0 / n).max(0.0)
+        let vov = if !(self.m2.is_finite() && self.m4.is_finite()) {
+            // The error bar's own error cannot be computed: say so.
+            f64::NAN
+        } else if self.m2 > 0.0 {
+            let m2_squared = self.m2 * self.m2;
+            let ratio = if m2_squared.is_finite() {
+                self.m4 / m2_squared
+            } else {
+                // Finite moments whose square overflows (weights ≳ 1e77).
+                self.m4 / self.m2 / self.m2
+            };
+            rounding_floor(ratio - 1.0 / n)
         } else {
             0.0
         };
@@ -167,6 +198,7 @@ impl Moments {
         Estimate {
             mean: self.mean,
             stderr: (variance / n).sqrt(),
+            nonzero: self.nonzero,
             n: self.n,
             vov,
             max_share,
@@ -175,15 +207,22 @@ impl Moments {
 }
 
 /// A Monte Carlo estimate with its error bar and tail diagnostics.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+///
+/// Serialised (JSON) as `mean`, `stderr`, `nonzero`, `reliable` (the value of
+/// [`Estimate::is_reliable`]), `n`, `vov` and `max_share`.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     /// Sample mean of the weights.
     pub mean: f64,
-    /// Standard error of the mean, `sqrt(var / N)` (0 for exact values).
+    /// Standard error of the mean, `sqrt(var / N)` (0 for exact values; NaN
+    /// or ∞ if the variance overflowed).
     pub stderr: f64,
+    /// Number of non-zero weights: how many paths contributed.
+    pub nonzero: u64,
     /// Number of samples (paths or path pairs).
     pub n: u64,
-    /// Relative variance of the variance estimate (see the module docs).
+    /// Relative variance of the variance estimate (see the module docs; NaN
+    /// if the moments overflowed).
     pub vov: f64,
     /// Largest weight's share of `Σ|w|`.
     pub max_share: f64,
@@ -192,22 +231,45 @@ pub struct Estimate {
 impl Estimate {
     /// VOV above which the error bar is flagged as unreliable (MCNP's rule).
     pub const VOV_LIMIT: f64 = 0.1;
+
+    /// Fewest non-zero weights for a reliable error bar.
+    ///
+    /// With `k` equal non-zero weights among `N ≫ k` zeros the VOV is
+    /// `1/k − 1/N`, so [`VOV_LIMIT`](Self::VOV_LIMIT) already flags fewer
+    /// than about 10 of them, except where the VOV cannot see: at `k = 0`
+    /// (every weight 0: `0 ± 0`, VOV 0) and for a few weights that happen
+    /// to be alike. Ten non-zero weights is the same bar stated as a count:
+    /// a Poisson count of 10 is known to ±32 %, and so is an error bar that
+    /// rests on it. A quantity that is exactly 0 (no path can contribute) is
+    /// therefore flagged too: the sample cannot tell it from a quantity
+    /// whose contributing paths were never drawn.
+    pub const MIN_NONZERO: u64 = 10;
+
     /// An exact value: zero error, no samples.
     pub fn exact(value: f64) -> Estimate {
         Estimate {
             mean: value,
             stderr: 0.0,
+            nonzero: 0,
             n: 0,
             vov: 0.0,
             max_share: 0.0,
         }
     }
 
-    /// False when the VOV says the error bar cannot be trusted. The largest
-    /// weight's share is reported beside it for the reader to judge (it is
-    /// at least 1/N, so no fixed threshold suits every N).
+    /// Whether the error bar can be trusted. A sampled estimate (`n > 0`) is
+    /// reliable when its mean, standard error and VOV are finite, at least
+    /// [`MIN_NONZERO`](Self::MIN_NONZERO) weights were non-zero, and the VOV
+    /// is below [`VOV_LIMIT`](Self::VOV_LIMIT). An exact value (`n = 0`) is
+    /// reliable when finite. The largest weight's share is reported beside
+    /// it for the reader to judge (it is at least 1/N, so no fixed threshold
+    /// suits every N).
     pub fn is_reliable(&self) -> bool {
-        self.vov < Self::VOV_LIMIT
+        let finite = self.mean.is_finite() && self.stderr.is_finite() && self.vov.is_finite();
+        if self.n == 0 {
+            return finite;
+        }
+        finite && self.nonzero >= Self::MIN_NONZERO && self.vov < Self::VOV_LIMIT
     }
 
     /// Distance from `reference` in standard errors (∞ if the error bar is 0
@@ -215,6 +277,20 @@ impl Estimate {
     pub fn z_score(&self, reference: f64) -> f64 {
         let d = (self.mean - reference).abs();
         if d == 0.0 { 0.0 } else { d / self.stderr }
+    }
+}
+
+impl Serialize for Estimate {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut s = serializer.serialize_struct("Estimate", 7)?;
+        s.serialize_field("mean", &self.mean)?;
+        s.serialize_field("stderr", &self.stderr)?;
+        s.serialize_field("nonzero", &self.nonzero)?;
+        s.serialize_field("reliable", &self.is_reliable())?;
+        s.serialize_field("n", &self.n)?;
+        s.serialize_field("vov", &self.vov)?;
+        s.serialize_field("max_share", &self.max_share)?;
+        s.end()
     }
 }
 
@@ -261,5 +337,88 @@ mod tests {
         assert!(e.vov > 0.9 && e.max_share == 1.0 && !e.is_reliable());
         // constant weights: zero variance, reliable
         assert!(Moments::of(&[3.0; 10]).estimate().is_reliable());
+    }
+
+    #[test]
+    fn overflowed_moments_give_no_error_bar() {
+        // d² overflows: the variance is not 0 but unknown.
+        let w: Vec<f64> = (0..100).map(|i| [1e200, -1e200, 3e200][i % 3]).collect();
+        let one = Moments::of(&w);
+        assert!(one.m2.is_nan() || one.m2 == f64::INFINITY, "{one:?}");
+        let merged = Moments::of(&w[..50]).merge(&Moments::of(&w[50..]));
+        for m in [one, merged] {
+            let e = m.estimate();
+            assert!(!e.stderr.is_finite() && !e.vov.is_finite(), "{e:?}");
+            assert!(!e.is_reliable());
+        }
+    }
+
+    #[test]
+    fn vov_survives_a_squared_variance_that_overflows() {
+        // M2² overflows while M4 does not: the VOV is scale-free, so it must
+        // equal the VOV of the same weights scaled down.
+        // The first weight (the accumulator's shift) is 1, near the mean:
+        // the shifted power sums stay finite.
+        let w: Vec<f64> = (0..2000)
+            .map(|i| {
+                if i % 97 == 2 {
+                    5.0
+                } else {
+                    ((i + 4) % 7) as f64 - 3.0
+                }
+            })
+            .collect();
+        let small = Moments::of(&w).estimate();
+        let big_w: Vec<f64> = w.iter().map(|x| x * 4e75).collect();
+        let big = Moments::of(&big_w);
+        assert!(!(big.m2 * big.m2).is_finite() && big.m4.is_finite());
+        let big = big.estimate();
+        approx::assert_relative_eq!(big.vov, small.vov, max_relative = 1e-12);
+        assert!(small.vov > 0.0 && big.is_reliable());
+    }
+
+    #[test]
+    fn nonzero_weights_are_counted_and_required() {
+        let mut w = vec![0.0; 990];
+        w.extend([0.5; 10]);
+        let m = Moments::of(&w[..500]).merge(&Moments::of(&w[500..]));
+        assert_eq!((m.n, m.nonzero), (1000, 10));
+        // Nothing sampled: 0 ± 0, and unreliable although the VOV is 0.
+        let zero = Moments::of(&[0.0; 1000]).estimate();
+        assert_eq!((zero.mean, zero.stderr, zero.vov), (0.0, 0.0, 0.0));
+        assert_eq!(zero.nonzero, 0);
+        assert!(!zero.is_reliable());
+        // Few weights, all alike: the VOV is 0, the count flags them.
+        assert!(!Moments::of(&[3.0; 9]).estimate().is_reliable());
+        assert!(Moments::of(&[3.0; 10]).estimate().is_reliable());
+        // An exact value needs no samples.
+        assert!(Estimate::exact(0.0).is_reliable());
+        assert!(!Estimate::exact(f64::NAN).is_reliable());
+    }
+
+    #[test]
+    fn json_carries_nonzero_and_reliable_beside_mean_and_stderr() {
+        let e = Moments::of(&[0.0, 1.0, 2.0]).estimate();
+        let json = serde_json::to_value(e).unwrap();
+        let keys: Vec<&str> = json
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(|k| k.as_str())
+            .collect();
+        assert_eq!(
+            keys,
+            [
+                "mean",
+                "stderr",
+                "nonzero",
+                "reliable",
+                "n",
+                "vov",
+                "max_share"
+            ]
+        );
+        assert_eq!(json["nonzero"], 2);
+        assert_eq!(json["reliable"], false);
     }
 }

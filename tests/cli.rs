@@ -85,8 +85,14 @@ fn json_has_exactly_the_documented_keys_and_nulls() {
         {
             if present {
                 let q = v[key].as_object().unwrap();
-                assert_eq!(q.len(), 2, "{method} {key}: {q:?}");
+                // mean, stderr, and (issue 11) the count of non-zero
+                // weights and whether the error bar can be trusted.
+                assert_eq!(q.len(), 4, "{method} {key}: {q:?}");
                 assert!(q["mean"].is_f64() && q["stderr"].is_f64(), "{method} {key}");
+                assert!(
+                    q["nonzero"].is_u64() && q["reliable"].is_boolean(),
+                    "{method} {key}"
+                );
             } else {
                 assert!(v[key].is_null(), "{method}: {key} should be null");
             }
@@ -443,4 +449,66 @@ fn bad_fd_steps_are_rejected_with_their_name() {
         args.extend(PROBE);
         assert_rejected(&args, 1, &["--fd-step", "--method fd", method]);
     }
+}
+
+#[test]
+fn issue_11_inputs_end_with_an_answer_or_a_message() {
+    // 2⁶⁴ − 1 paths used to abort allocating per-chunk moments: refused now,
+    // with the count printed exactly.
+    let mut huge = vec!["rod", "--method", "expectation", "--paths"];
+    huge.push("18446744073709551615");
+    huge.extend(PROBE);
+    assert_rejected(&huge, 1, &["paths = 18446744073709551615", "2^53"]);
+    // Sensitivity weights ~1e300 whose squares overflow: an error, not a
+    // reliable ± 0.
+    assert_rejected(
+        &[
+            "rod",
+            "--method",
+            "expectation",
+            "--ks",
+            "1e300",
+            "--ke",
+            "1e300",
+            "--length",
+            "1e-300",
+            "--x",
+            "1e-300",
+            "--omega",
+            "1",
+            "--paths",
+            "2000",
+        ],
+        1,
+        &["∂I/∂length", "NaN", "overflow"],
+    );
+    // The thick rod in units of 1e200: the exact solution is the thick rod's.
+    let out = geosens(&[
+        "rod", "--method", "exact", "--ks", "2.1e-200", "--ke", "3e-200", "--length", "2e200",
+        "--x", "1e200", "--omega", "1", "--json",
+    ]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let i = v["intensity"]["mean"].as_f64().unwrap();
+    assert!((i - 0.19277216180520562).abs() < 1e-13, "I = {i}");
+    // κe π̃ = 10⁴ with albedo ½: 10⁴ paths end (they took 22 ms each).
+    let out = geosens(&[
+        "rod",
+        "--method",
+        "transport",
+        "--ks",
+        "5e5",
+        "--ke",
+        "1e6",
+        "--length",
+        "0.01",
+        "--x",
+        "0.005",
+        "--omega",
+        "1",
+        "--paths",
+        "10000",
+        "--json",
+    ]);
+    assert!(out.status.success());
 }

@@ -5,8 +5,9 @@
 //! threads.
 mod common;
 use common::*;
+use geosens::rod::walk::{Events, walk};
 use geosens::rod::{Direction, Method, Probe, Rod};
-use geosens::{Quantity, RunConfig, run};
+use geosens::{Quantity, RunConfig, rng, run};
 
 const XS: [f64; 7] = [0.0, 0.25, 0.5, 1.0, 1.5, 1.9, 2.0];
 
@@ -114,5 +115,67 @@ fn bit_identical_for_one_and_two_threads() {
         assert_eq!(one.estimates, three.estimates, "{}", method.name());
         let other_seed = run(est.as_ref(), &RunConfig::new(cfg.paths, 100).unwrap()).unwrap();
         assert_ne!(one.estimates, other_seed.estimates);
+    }
+}
+
+/// Counts a walk's collisions.
+struct Collisions(u64);
+
+impl Events for Collisions {
+    fn collision(&mut self, _dir: Direction, _xi: f64, _d: f64) {
+        self.0 += 1;
+    }
+}
+
+/// `κe π̃ = 10⁴`, albedo ½ (issue 11, item 7): a path from the middle needs
+/// ~(κs π̃/2)² ≈ 6·10⁶ collisions to escape, while its weight `e^{−κa L}` is
+/// 0 in f64 after ~750.
+fn absorbing_thick_rod() -> Rod {
+    Rod::new(5e5, 1e6, 0.01).unwrap()
+}
+
+#[test]
+fn walks_stop_once_their_weight_is_zero() {
+    let rod = absorbing_thick_rod();
+    let mut rng = rng::stream(1, 0);
+    for i in 0..200 {
+        let (x, dir) = if i % 2 == 0 {
+            (0.005, Direction::Left)
+        } else {
+            (0.0, Direction::Right)
+        };
+        let mut count = Collisions(0);
+        let _ = walk(&rod, x, dir, &mut rng, &mut count);
+        // e^{−κa L} underflows at κa L ≈ 745, reached after ~745 ± 30 free
+        // paths of mean 1/κs = 1/κa.
+        assert!(count.0 < 1000, "walk {i} from {x}: {} collisions", count.0);
+    }
+}
+
+#[test]
+fn absorbing_thick_rods_stay_unbiased() {
+    // Every method at 10⁴ paths (a fraction of a second in release) within
+    // 4σ of exact: the reflection I(0, −1) ≈ 0.17, the transmitted
+    // intensity and its gradient near the lit end, and the middle, where
+    // every quantity is 0 in f64 (e^{−3535}) and every estimate is an
+    // unreliable 0 ± 0.
+    let rod = absorbing_thick_rod();
+    for method in Method::UNBIASED {
+        for (x, omega) in [
+            (0.0, Direction::Left),
+            (1e-6, Direction::Right),
+            (1e-6, Direction::Left),
+            (0.005, Direction::Right),
+        ] {
+            assert_within(method, rod, x, omega, 10_000, 3, 4.0);
+        }
+        let middle = estimate(method, rod, 0.005, Direction::Right, 10_000, 3);
+        for (q, e) in &middle.estimates {
+            assert_eq!((e.mean, e.nonzero), (0.0, 0), "{} {q}", method.name());
+            assert!(!e.is_reliable());
+        }
+        let reflected = estimate(method, rod, 0.0, Direction::Left, 10_000, 3);
+        let i = reflected.get(&Quantity::Intensity).unwrap();
+        assert!(i.mean > 0.1 && i.is_reliable(), "{}: {i:?}", method.name());
     }
 }

@@ -202,3 +202,92 @@ fn very_thick_rods_do_not_overflow() {
         }
     }
 }
+
+/// Asserts `scaled == unit / c`: exactly where that is a normal number (the
+/// scaling by a power of two commutes with rounding), within two of the
+/// smallest subnormals where it underflows.
+fn assert_scaled(what: &str, scaled: f64, unit: f64, c: f64) {
+    let want = unit / c;
+    let ok = if want.abs() >= f64::MIN_POSITIVE {
+        scaled == want
+    } else {
+        (scaled - want).abs() <= 2.0 * f64::from_bits(1)
+    };
+    assert!(ok, "{what}: {scaled:e} at scale {c:e}, want {want:e}");
+}
+
+#[test]
+fn only_optical_variables_matter_at_every_scale() {
+    // Lengths times c = 2^k, coefficients over c: κ·length, the albedo and
+    // x/length are the same bits, so I must be too, and s and ∂xI (per unit
+    // length) exactly 1/c times the unit-scale values. With k = ±664 the
+    // product κe·κa of the old `k = √(κe κa)` underflowed or overflowed.
+    for (name, rod) in rods() {
+        for k in [-1000, -664, -300, 300, 664, 1000] {
+            let c = 2f64.powi(k);
+            let scaled = Rod::new(rod.ks / c, rod.ke / c, rod.length * c)
+                .unwrap()
+                .with_incoming(rod.incoming)
+                .unwrap();
+            for i in 0..=8 {
+                let x = rod.length * i as f64 / 8.0;
+                for omega in [Direction::Right, Direction::Left] {
+                    let what = format!("{name} at x = {x}·2^{k}, {omega:?}");
+                    let unit = exact::solve(&rod, x, omega);
+                    let e = exact::solve(&scaled, x * c, omega);
+                    assert_eq!(e.intensity, unit.intensity, "I: {what}");
+                    assert_scaled(&format!("s: {what}"), e.sensitivity, unit.sensitivity, c);
+                    assert_scaled(&format!("∂xI: {what}"), e.gradient_x, unit.gradient_x, c);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn extreme_unit_scales_of_the_issue() {
+    // `--ks 2.1e-200 --ke 3e-200 --length 2e200 --x 1e200 --omega 1` is the
+    // thick rod at x = 1 (I = 0.1928), not I = 0.602.
+    let unit = exact::solve(&Rod::new(2.1, 3.0, 2.0).unwrap(), 1.0, Direction::Right);
+    let rod = Rod::new(2.1e-200, 3e-200, 2e200).unwrap();
+    let e = exact::solve(&rod, 1e200, Direction::Right);
+    assert!(close(e.intensity, unit.intensity, 1e-13, unit.intensity));
+    assert!(close(
+        e.sensitivity * 1e200,
+        unit.sensitivity,
+        1e-13,
+        unit.sensitivity
+    ));
+    assert!(close(
+        e.gradient_x * 1e200,
+        unit.gradient_x,
+        1e-13,
+        unit.gradient_x.abs()
+    ));
+    // An empty rod of length 1e308: I = I0 looking right, 0 looking left, no
+    // sensitivity (the old evaluation gave NaN: e^{−0·2π̃} with 2π̃ = ∞).
+    let empty = Rod::new(0.0, 0.0, 1e308).unwrap();
+    for x in [0.0, 1.0, 5e307, 1e308] {
+        let right = exact::solve(&empty, x, Direction::Right);
+        let left = exact::solve(&empty, x, Direction::Left);
+        assert_eq!(
+            (right.intensity, right.sensitivity, right.gradient_x),
+            (1.0, 0.0, 0.0)
+        );
+        assert_eq!(
+            (left.intensity, left.sensitivity, left.gradient_x),
+            (0.0, 0.0, 0.0)
+        );
+    }
+    // Optical thickness 1 at the scale 1e-300: s ≈ 1e299, finite (was ∞).
+    let tiny = Rod::new(1e300, 1e300, 1e-300).unwrap();
+    let unit = exact::solve(&Rod::new(1.0, 1.0, 1.0).unwrap(), 1.0, Direction::Right);
+    let e = exact::solve(&tiny, 1e-300, Direction::Right);
+    assert!(close(e.intensity, unit.intensity, 1e-14, 1.0));
+    assert!(close(
+        e.sensitivity * 1e-300,
+        unit.sensitivity,
+        1e-13,
+        unit.sensitivity
+    ));
+}

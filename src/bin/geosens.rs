@@ -16,6 +16,7 @@
 //! parse errors exit with status 2).
 use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use geosens::error::Num;
 use geosens::rod::{Direction, Probe, Rod, exact};
 use geosens::{Error, Estimate, Estimator, Method, Problem, Quantity, RunConfig, RunResult, run};
 use serde::Serialize;
@@ -256,13 +257,52 @@ fn exact_result(rod: &Rod, probe: &Probe) -> RunResult {
     }
 }
 
-/// Mean and standard error, as the JSON line prints them.
+/// Mean and standard error, as the JSON line prints them, with the count
+/// of non-zero weights and whether the error bar can be trusted.
 #[derive(Serialize)]
 struct MeanErr {
     /// Estimated value.
     mean: f64,
     /// Its standard error (0 for `exact`).
     stderr: f64,
+    /// Paths whose weight was not zero (0 for `exact`).
+    nonzero: u64,
+    /// Whether the error bar can be trusted ([`Estimate::is_reliable`] and
+    /// no caveat).
+    reliable: bool,
+    /// Why the estimate may be far off whatever its error bar, if the
+    /// estimator said so when it was built.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    caveat: Option<String>,
+}
+
+impl MeanErr {
+    /// The JSON form of `e`, with the caveat on its quantity if any.
+    fn of(e: &Estimate, caveat: Option<&String>) -> MeanErr {
+        MeanErr {
+            mean: e.mean,
+            stderr: e.stderr,
+            nonzero: e.nonzero,
+            reliable: e.is_reliable() && caveat.is_none(),
+            caveat: caveat.cloned(),
+        }
+    }
+}
+
+/// The caveat the estimator raised on quantity `q`, if any.
+fn caveat_of<'a>(caveats: &'a [(Quantity, String)], q: &Quantity) -> Option<&'a String> {
+    caveats.iter().find(|(k, _)| k == q).map(|(_, why)| why)
+}
+
+/// `z` as the tables print it: `-` where the error bar is 0 and the
+/// estimate is off (no finite z; `reliable` says why).
+fn z_text(e: &Estimate, exact: f64) -> String {
+    let z = e.z_score(exact);
+    if z.is_finite() {
+        format!("{z:.1}")
+    } else {
+        "-".to_owned()
+    }
 }
 
 /// The one JSON line of `geosens rod --json`; `None` prints `null` for a
@@ -293,7 +333,9 @@ fn all_finite(result: &RunResult) -> Result<(), String> {
     {
         Some((q, e)) => Err(format!(
             "method {} gives {q} = {} ± {} at these inputs (floating-point overflow)",
-            result.method, e.mean, e.stderr
+            result.method,
+            Num(e.mean),
+            Num(e.stderr)
         )),
         None => Ok(()),
     }
@@ -316,12 +358,7 @@ fn rod_command(args: &RodArgs, out: &mut impl Write) -> Result<(), Box<dyn std::
     };
     all_finite(&result)?;
     if args.json {
-        let [i, s, g] = quantities().map(|q| {
-            result.get(&q).map(|e| MeanErr {
-                mean: e.mean,
-                stderr: e.stderr,
-            })
-        });
+        let [i, s, g] = quantities().map(|q| result.get(&q).map(|e| MeanErr::of(&e, None)));
         let line = JsonLine {
             method: result.method,
             intensity: i,
@@ -349,8 +386,8 @@ fn rod_command(args: &RodArgs, out: &mut impl Write) -> Result<(), Box<dyn std::
     )?;
     writeln!(
         out,
-        "{:<12} {:>14} {:>11} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
-        "quantity", "mean", "stderr", "n", "vov", "max_share", "reliable", "exact", "z"
+        "{:<12} {:>14} {:>11} {:>9} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
+        "quantity", "mean", "stderr", "n", "nonzero", "vov", "max_share", "reliable", "exact", "z"
     )?;
     let exact = exact_values(&rod, &probe);
     for (q, e) in &result.estimates {
@@ -358,16 +395,17 @@ fn rod_command(args: &RodArgs, out: &mut impl Write) -> Result<(), Box<dyn std::
         let mc = e.n > 0;
         writeln!(
             out,
-            "{:<12} {:>14.6e} {:>11.2e} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
+            "{:<12} {:>14.6e} {:>11.2e} {:>9} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
             q.to_string(),
             e.mean,
             e.stderr,
             e.n,
+            dash(mc, || e.nonzero.to_string()),
             dash(mc, || format!("{:.1e}", e.vov)),
             dash(mc, || format!("{:.1e}", e.max_share)),
             dash(mc, || yes_no(e.is_reliable()).to_owned()),
             dash(mc, || format!("{ex:.6e}")),
-            dash(mc, || format!("{:.1}", e.z_score(ex))),
+            dash(mc, || z_text(e, ex)),
         )?;
     }
     Ok(())
@@ -397,10 +435,10 @@ fn cell(e: Option<Estimate>, exact: f64) -> String {
         None => format!("{:>10}", "-"),
         Some(e) if e.n == 0 => format!("{:>10.6}", e.mean),
         Some(e) => format!(
-            "{:>10.6} ± {:<7.1e} z {:>4.1}{}",
+            "{:>10.6} ± {:<7.1e} z {:>4}{}",
             e.mean,
             e.stderr,
-            e.z_score(exact),
+            z_text(&e, exact),
             if e.is_reliable() { "" } else { "!" }
         ),
     }
@@ -476,8 +514,9 @@ fn compare_command(
     writeln!(
         out,
         "\nper method over the 16 probes (z: distance to exact in stderrs; \
-         !: VOV ≥ {}, error bar unreliable)",
-        Estimate::VOV_LIMIT
+         !: error bar unreliable: VOV ≥ {}, fewer than {} non-zero weights, or not finite)",
+        Estimate::VOV_LIMIT,
+        Estimate::MIN_NONZERO
     )?;
     writeln!(
         out,
@@ -551,29 +590,25 @@ fn flat_command(args: &FlatArgs, out: &mut impl Write) -> Result<(), Box<dyn std
         .estimator(args.method, scene.clone(), Some(&args.scene))?;
     let result = run(estimator.as_ref(), &cfg)?;
     all_finite(&result)?;
+    let caveats = estimator.caveats();
+    for (q, why) in &caveats {
+        eprintln!("warning: {q}: {why}");
+    }
     if args.json {
-        let value = |e: &Estimate| {
-            serde_json::to_value(MeanErr {
-                mean: e.mean,
-                stderr: e.stderr,
-            })
+        let value = |q: &Quantity, e: &Estimate| {
+            serde_json::to_value(MeanErr::of(e, caveat_of(&caveats, q)))
         };
         let mut intensity = None;
         let mut sensitivity = serde_json::Map::new();
         let mut gradient = serde_json::Map::new();
         for (q, e) in &result.estimates {
             match q {
-                Quantity::Intensity => {
-                    intensity = Some(MeanErr {
-                        mean: e.mean,
-                        stderr: e.stderr,
-                    })
-                }
+                Quantity::Intensity => intensity = Some(MeanErr::of(e, caveat_of(&caveats, q))),
                 Quantity::Sensitivity(p) => {
-                    sensitivity.insert(p.clone(), value(e)?);
+                    sensitivity.insert(p.clone(), value(q, e)?);
                 }
                 Quantity::Gradient(a) => {
-                    gradient.insert(a.clone(), value(e)?);
+                    gradient.insert(a.clone(), value(q, e)?);
                 }
             }
         }
@@ -602,19 +637,25 @@ fn flat_command(args: &FlatArgs, out: &mut impl Write) -> Result<(), Box<dyn std
     )?;
     writeln!(
         out,
-        "{:<20} {:>14} {:>11} {:>9} {:>9} {:>8}",
-        "quantity", "mean", "stderr", "vov", "max_share", "reliable"
+        "{:<20} {:>14} {:>11} {:>9} {:>9} {:>9} {:>8}",
+        "quantity", "mean", "stderr", "nonzero", "vov", "max_share", "reliable"
     )?;
     for (q, e) in &result.estimates {
+        let caveat = caveat_of(&caveats, q);
         writeln!(
             out,
-            "{:<20} {:>14.6e} {:>11.2e} {:>9.1e} {:>9.1e} {:>8}",
+            "{:<20} {:>14.6e} {:>11.2e} {:>9} {:>9.1e} {:>9.1e} {:>8}",
             q.to_string(),
             e.mean,
             e.stderr,
+            e.nonzero,
             e.vov,
             e.max_share,
-            yes_no(e.is_reliable())
+            match (e.is_reliable(), caveat) {
+                (true, None) => "yes",
+                (_, Some(_)) => "caveat",
+                (false, None) => "no",
+            }
         )?;
     }
     Ok(())

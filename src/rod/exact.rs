@@ -16,6 +16,14 @@
 //! y·(1 − e^{−2ky})/(2ky)` through `expm1`: no overflow for thick rods, no
 //! `0/0` at `κa = 0` (`k = 0`), exact at `κs = 0`. The book's chapter "The
 //! rod and its exact solution" has the derivation.
+//!
+//! Only optical quantities matter: `I` depends on `κe π̃`, `κs π̃` and
+//! `x/π̃` alone, and `s`, `∂xI` are `1/π̃` times functions of them. So the
+//! solution is evaluated in optical units (lengths over `π̃`, coefficients
+//! times `π̃`), where every number is at most the optical thickness (≤ 10⁴),
+//! and `s`, `∂xI` are divided by `π̃` last. In physical units `κe κa`
+//! underflows from `κ ≈ 1e-162` and `2π̃` overflows from `π̃ ≈ 9e307`, while
+//! the rod's validation accepts both.
 use super::{Direction, Rod};
 use crate::estimator::Quantity;
 
@@ -56,29 +64,36 @@ fn scaled(k: f64, y: f64) -> (f64, f64) {
 
 /// The exact `I`, `s` and `∂xI` at `x ∈ [0, π̃]` in direction `omega`.
 pub fn solve(rod: &Rod, x: f64, omega: Direction) -> Solution {
-    let (a, b) = (rod.ke - 0.5 * rod.ks, 0.5 * rod.ks);
-    let k = (rod.ke * rod.ka()).max(0.0).sqrt();
+    // Optical units: the rod is [0, 1], coefficients are optical depths
+    // (each ≤ κe π̃ ≤ 10⁴: no overflow, and κa π̃ from κe − κs directly).
+    let l = rod.length;
+    let (tau_e, tau_s, tau_a) = (rod.ke * l, rod.ks * l, rod.ka() * l);
+    let (a, b) = (tau_e - 0.5 * tau_s, 0.5 * tau_s);
+    let k = (tau_e * tau_a).sqrt();
+    // The probe, and its distance to the moving end (exact near that end).
+    let (x, y) = (x / l, (l - x) / l);
     let f = |(c, s): (f64, f64)| c + a * s;
     let df = |(c, s): (f64, f64)| k * k * s + a * c;
-    let at_y = scaled(k, rod.length - x);
+    let at_y = scaled(k, y);
     let at_x = scaled(k, x);
-    let g = f(scaled(k, rod.length));
-    // e^{−kx} relates the scalings of y = π̃ − x and π̃; e^{−k(2π̃−x)} those of
-    // x and π̃² in the sensitivity's product form.
+    let g = f(scaled(k, 1.0));
+    // e^{−kx} relates the scalings of y = 1 − x and 1; e^{−k(1 + y)} those of
+    // x and 1² in the sensitivity's product form.
     let scale = rod.incoming * (-k * x).exp() / g;
-    let scale_s = rod.incoming * b * (-k * (2.0 * rod.length - x)).exp() / (g * g);
+    let scale_s = rod.incoming * b * (-k * (1.0 + y)).exp() / (g * g);
+    // s and ∂xI are rates per unit length: back to physical units by 1/π̃.
     match omega {
         Direction::Right => Solution {
             intensity: scale * f(at_y),
-            // f'(y) f(π̃) − f(y) f'(π̃) = b² S(x): no cancellation.
-            sensitivity: scale_s * b * at_x.1,
-            gradient_x: -scale * df(at_y),
+            // f'(y) f(1) − f(y) f'(1) = b² S(x): no cancellation.
+            sensitivity: scale_s * b * at_x.1 / l,
+            gradient_x: -scale * df(at_y) / l,
         },
         Direction::Left => Solution {
             intensity: scale * b * at_y.1,
-            // C(y) f(π̃) − S(y) f'(π̃) = f(x).
-            sensitivity: scale_s * f(at_x),
-            gradient_x: -scale * b * at_y.0,
+            // C(y) f(1) − S(y) f'(1) = f(x).
+            sensitivity: scale_s * f(at_x) / l,
+            gradient_x: -scale * b * at_y.0 / l,
         },
     }
 }

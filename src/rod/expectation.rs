@@ -99,7 +99,11 @@ impl Estimator for ExpectationEstimator {
             return;
         }
         let mut v = DomainVelocity::default();
-        let exit = walk(rod, self.probe.x, dir, rng, &mut v);
+        let Some(exit) = walk(rod, self.probe.x, dir, rng, &mut v) else {
+            // Absorbed: W = 0, and so is W (R − κe Λ).
+            weights.fill(0.0);
+            return;
+        };
         let w = score(rod, exit.side, exit.length);
         weights[0] = w;
         weights[1] = w * (v.divergence - rod.ke * v.length);

@@ -35,7 +35,11 @@ impl Estimator for RenderingEstimator {
     #[inline]
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
         let rod = &self.rod;
-        let exit = walk(rod, self.probe.x, self.probe.omega.reverse(), rng, &mut ());
+        let Some(exit) = walk(rod, self.probe.x, self.probe.omega.reverse(), rng, &mut ()) else {
+            // Absorbed: every weight carries e^{−κa L} = 0.
+            weights.fill(0.0);
+            return;
+        };
         match exit.side {
             Side::Start => {
                 weights[0] = score(rod, Side::Start, exit.length);
@@ -46,8 +50,12 @@ impl Estimator for RenderingEstimator {
                 // I(π̃, +1) is seen by a backward path from π̃ travelling left;
                 // its absorption and the primary's share one exponential.
                 weights[1] = if rod.ks > 0.0 {
-                    let nested = walk(rod, rod.length, Direction::Left, rng, &mut ());
-                    0.5 * rod.ks * score(rod, nested.side, exit.length + nested.length)
+                    match walk(rod, rod.length, Direction::Left, rng, &mut ()) {
+                        Some(nested) => {
+                            0.5 * rod.ks * score(rod, nested.side, exit.length + nested.length)
+                        }
+                        None => 0.0,
+                    }
                 } else {
                     0.0
                 };

@@ -66,7 +66,8 @@ fn nested_intensity(rod: &Rod, x: f64, dir: Direction, rng: &mut PathRng) -> f64
 
 /// Solves the transport model for the fields whose boundary sources `source`
 /// gives: walks from `x` along `dir` and returns the attenuated sources at
-/// the exit.
+/// the exit (0 for an absorbed path: every source is attenuated by
+/// `e^{−κa L} = 0`, so its nested paths need not be drawn).
 #[inline]
 pub fn solve<const N: usize>(
     rod: &Rod,
@@ -75,7 +76,9 @@ pub fn solve<const N: usize>(
     rng: &mut PathRng,
     source: impl FnOnce(Side, &mut PathRng) -> [f64; N],
 ) -> [f64; N] {
-    let exit = walk(rod, x, dir, rng, &mut ());
+    let Some(exit) = walk(rod, x, dir, rng, &mut ()) else {
+        return [0.0; N];
+    };
     let s = source(exit.side, rng);
     if s.iter().all(|&v| v == 0.0) {
         // Nothing to attenuate: skip the exponential (a · ±0 = ±0 anyway).

@@ -146,6 +146,7 @@ pub fn finite_difference(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         let independent = Estimate {
             mean: (a.mean - b.mean) / (2.0 * h),
             stderr: a.stderr.hypot(b.stderr) / (2.0 * h),
+            nonzero: a.nonzero.min(b.nonzero),
             n: a.n,
             vov: a.vov.max(b.vov),
             max_share: a.max_share.max(b.max_share),
