@@ -245,3 +245,39 @@ fn numbers_in_messages_are_short_and_flags_name_themselves() {
     let (code, _, err) = run_flat(&path, "intensity", "1000");
     assert_eq!(code, 0, "{err}");
 }
+
+#[test]
+fn finite_differences_across_a_change_of_view_are_flagged() {
+    // An occluder's corner 1e-4 above the sensor: the default step swings it
+    // past the zenith; the quotient (−223.5 for an exact −10⁴) used to be
+    // reported reliable. Now a warning, `reliable: false` and the caveat.
+    let text =
+        occluder(1.0, "").replace("[[-6e-1, 1e0], [2e-1, 1e0]]", "[[-0.6, 1e-4], [0.0, 1e-4]]");
+    assert!(text.contains("1e-4"), "{text}");
+    let path = scene_file("corner_over_sensor.toml", &text);
+    let (code, out, err) = run_flat(&path, "fd", "20000");
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("warning") && err.contains("occ_tx"), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let s = &v["sensitivity"]["occ_tx"];
+    assert_eq!(s["reliable"], false, "{s}");
+    assert!(s["caveat"].as_str().unwrap().contains("--fd-step"), "{s}");
+    // A step inside the corner's height: no caveat.
+    let args = [
+        "flat",
+        "--scene",
+        path.to_str().unwrap(),
+        "--method",
+        "fd",
+        "--fd-step",
+        "1e-6",
+        "--paths",
+        "20000",
+        "--json",
+    ];
+    let (code, out, err) = geosens(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v["sensitivity"]["occ_tx"].get("caveat").is_none(), "{v}");
+}

@@ -1,0 +1,278 @@
+//! The `geosens` command line.
+//!
+//! - `geosens rod --method M --ks F --ke F --length F --x F --omega ±1 [--json]`
+//!   estimates `I`, `s = ∂I/∂length` (and `∂I/∂x` for `transport`) at one
+//!   probe on a rod with one method, or evaluates the exact solution
+//!   (`--method exact`), and prints a table or one JSON line;
+//! - `geosens flat --scene FILE --method M [--json]` does the same for every
+//!   parameter of a flatland scene file (`--fd-step H` sets the half step of
+//!   `--method fd`, on both subcommands);
+//! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
+//!   and thick rods at a few probes and prints them beside the exact solution,
+//!   then writes the rod's figures and flatland's (`flat_*`) (with the
+//!   `figures` feature, on by default).
+//!
+//! Bad input exits with status 1 and `error: …` naming the value (clap's own
+//! parse errors exit with status 2).
+use clap::builder::PossibleValue;
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use geosens::error::Num;
+use geosens::rod::{Direction, Probe, Rod, exact};
+use geosens::{Error, Estimate, Estimator, Method, Problem, Quantity, RunConfig, RunResult, run};
+use serde::Serialize;
+use std::io::{self, Write};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Most worker threads accepted by `--threads`: beyond it a pool would cost
+/// more to start than the runs it serves (and rayon itself stops at 65535).
+const MAX_THREADS: usize = 1024;
+
+/// Monte Carlo estimates of intensity and geometric sensitivities.
+#[derive(Debug, Parser)]
+#[command(name = "geosens", version, about)]
+struct Cli {
+    /// What to run.
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Estimate I, ∂I/∂length (and ∂I/∂x) at one probe on a rod.
+    Rod(RodArgs),
+    /// Compare the four methods with the exact solution on the paper's rods,
+    /// then write the rod's figures and flatland's.
+    Compare(CompareArgs),
+    /// Estimate I and ∂I/∂π for every parameter of a flatland scene file.
+    Flat(FlatArgs),
+}
+
+/// `geosens flat`: a scene file, a method, a run.
+#[derive(Debug, Args)]
+struct FlatArgs {
+    /// Scene file (TOML or JSON; see scenes/).
+    #[arg(long)]
+    scene: std::path::PathBuf,
+    /// Estimation method.
+    #[arg(long, value_enum)]
+    method: Method,
+    /// The finite differences' half step.
+    #[command(flatten)]
+    fd: FdArgs,
+    /// The run configuration.
+    #[command(flatten)]
+    run: RunArgs,
+    /// Print one JSON line instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `--fd-step`, shared by `rod` and `flat`.
+#[derive(Debug, Args)]
+struct FdArgs {
+    /// Half step of `--method fd`: relative to the scene's size (the rod's
+    /// length) for a translation, radians for a rotation, the relative
+    /// change for a scale; in (0, 1) [default: 0.001].
+    #[arg(long, allow_hyphen_values = true)]
+    fd_step: Option<f64>,
+}
+
+impl FdArgs {
+    /// `method`'s estimator on `problem`, with `--fd-step` for `fd`. An
+    /// invalid displaced scene's error (`path`: its file, if any) gets a hint.
+    fn estimator(
+        &self,
+        method: Method,
+        problem: impl Problem,
+        path: Option<&std::path::Path>,
+    ) -> Result<Box<dyn Estimator>, Error> {
+        if self.fd_step.is_some() && method != Method::Fd {
+            return Err(Error::Config(format!(
+                "--fd-step sets the half step of --method fd, not of {method}"
+            )));
+        }
+        problem
+            .estimator(method, self.fd_step)
+            .map_err(|e| match e {
+                Error::Scene(msg) if msg.contains("displaced by") => {
+                    let file = path.map_or(String::new(), |p| format!("{}: ", p.display()));
+                    Error::Scene(format!("{file}{msg}; try a smaller --fd-step"))
+                }
+                other => other,
+            })
+    }
+}
+
+/// How to estimate: the method, the rod, the probe and the run. Float values
+/// may start with `-` (`--omega -1`, `--x -inf`) so that the library, not the
+/// parser, rejects them with its domain in the message.
+#[derive(Debug, Args)]
+#[command(allow_negative_numbers = true)]
+struct RodArgs {
+    /// Estimation method (`exact` evaluates the Bellman–Wing solution).
+    #[arg(long, value_enum)]
+    method: RodMethod,
+    /// Scattering coefficient κs (≥ 0).
+    #[arg(long, allow_hyphen_values = true)]
+    ks: f64,
+    /// Extinction coefficient κe (≥ κs).
+    #[arg(long, allow_hyphen_values = true)]
+    ke: f64,
+    /// Rod length π̃ (> 0), the shape parameter.
+    #[arg(long, allow_hyphen_values = true)]
+    length: f64,
+    /// Probe position x, 0 ≤ x ≤ length.
+    #[arg(long, allow_hyphen_values = true)]
+    x: f64,
+    /// Probe direction ω: 1 (right) or -1 (left).
+    #[arg(long, allow_hyphen_values = true)]
+    omega: f64,
+    /// The finite differences' half step.
+    #[command(flatten)]
+    fd: FdArgs,
+    /// The run configuration.
+    #[command(flatten)]
+    run: RunArgs,
+    /// Print one JSON line instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `geosens compare`: the table's run, and where the figures go.
+#[derive(Debug, Args)]
+struct CompareArgs {
+    /// The table's run configuration (the figures use the seed and threads).
+    #[command(flatten)]
+    run: RunArgs,
+    /// Folder the figures (PNG, SVG and the JSON of their numbers) go to.
+    #[arg(long, default_value = "out/figures")]
+    figures: std::path::PathBuf,
+    /// Multiplies the figures' path counts (1 = the book's figures).
+    #[arg(long, default_value_t = 1.0)]
+    effort: f64,
+    /// Print the table only.
+    #[arg(long)]
+    no_figures: bool,
+}
+
+/// Run configuration, shared by both subcommands.
+#[derive(Debug, Args)]
+struct RunArgs {
+    /// Number of paths per run, at least 2 [default: 1000000 for `rod`,
+    /// 200000 for `compare`] (`exact` samples none but checks it too).
+    // Hyphen values allowed so that `--paths -5` is named in the error
+    // ("invalid value '-5' for '--paths'") instead of an unexpected `-5`.
+    #[arg(long, allow_hyphen_values = true)]
+    paths: Option<u64>,
+    /// Seed of the random streams.
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
+    seed: u64,
+    /// Worker threads, 0 = all cores (results do not depend on it).
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
+    threads: usize,
+}
+
+impl RunArgs {
+    /// The validated configuration, `default_paths` if `--paths` is absent,
+    /// with `--threads` capped at [`MAX_THREADS`].
+    fn config(&self, default_paths: u64) -> Result<RunConfig, Error> {
+        if self.threads > MAX_THREADS {
+            return Err(Error::Config(format!(
+                "threads = {}: expected 0 (all cores) to {MAX_THREADS}",
+                self.threads
+            )));
+        }
+        let cfg = RunConfig::new(self.paths.unwrap_or(default_paths), self.seed)?;
+        Ok(cfg.threads(self.threads))
+    }
+}
+
+/// `--method` of `geosens rod`: a Monte Carlo [`Method`] or, listed first,
+/// `exact`, the Bellman–Wing solution (`None`).
+#[derive(Debug, Clone, Copy)]
+struct RodMethod(Option<Method>);
+
+impl ValueEnum for RodMethod {
+    fn value_variants<'a>() -> &'a [Self] {
+        const ALL: [RodMethod; 1 + Method::ALL.len()] = {
+            let mut all = [RodMethod(None); 1 + Method::ALL.len()];
+            let mut i = 0;
+            while i < Method::ALL.len() {
+                all[i + 1] = RodMethod(Some(Method::ALL[i]));
+                i += 1;
+            }
+            all
+        };
+        &ALL
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        match self.0 {
+            None => Some(PossibleValue::new("exact").help("Exact Bellman–Wing solution")),
+            Some(m) => m.to_possible_value(),
+        }
+    }
+}
+
+/// The three quantities a rod run can report, in table and JSON order.
+fn quantities() -> [Quantity; 3] {
+    [
+        Quantity::Intensity,
+        Quantity::sensitivity(geosens::rod::PARAMETER),
+        Quantity::gradient("x"),
+    ]
+}
+
+/// Position of `q` in [`quantities`].
+fn slot(q: &Quantity) -> usize {
+    match q {
+        Quantity::Intensity => 0,
+        Quantity::Sensitivity(_) => 1,
+        Quantity::Gradient(_) => 2,
+    }
+}
+
+/// The exact values of [`quantities`] at a probe.
+fn exact_values(rod: &Rod, probe: &Probe) -> [f64; 3] {
+    let e = exact::solve(rod, probe.x, probe.omega);
+    [e.intensity, e.sensitivity, e.gradient_x]
+}
+
+/// The exact solution as a [`RunResult`] (stderr 0, `paths` 0: nothing is
+/// sampled; `seconds` is the time of the evaluation).
+fn exact_result(rod: &Rod, probe: &Probe) -> RunResult {
+    let start = Instant::now();
+    let values = exact_values(rod, probe);
+    let seconds = start.elapsed().as_secs_f64();
+    RunResult {
+        method: "exact",
+        estimates: quantities()
+            .into_iter()
+            .zip(values.map(Estimate::exact))
+            .collect(),
+        paths: 0,
+        seconds,
+    }
+}
+
+mod commands;
+mod output;
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let mut out = io::stdout().lock();
+    let result = match &cli.command {
+        Command::Rod(args) => commands::rod_command(args, &mut out),
+        Command::Compare(args) => commands::compare_command(args, &mut out),
+        Command::Flat(args) => commands::flat_command(args, &mut out),
+    };
+    match result.and_then(|()| Ok(out.flush()?)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
