@@ -281,3 +281,41 @@ fn finite_differences_across_a_change_of_view_are_flagged() {
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert!(v["sensitivity"]["occ_tx"].get("caveat").is_none(), "{v}");
 }
+
+#[test]
+fn a_rod_whose_paths_would_never_end_is_refused_but_solved_exactly() {
+    // Conservative, κs × length = 10⁴: ~10⁸ collisions per path.
+    let rod = [
+        "--ks", "50", "--ke", "50", "--length", "200", "--x", "100", "--omega", "1",
+    ];
+    for method in ["intensity", "expectation", "rendering", "transport", "fd"] {
+        let mut args = vec!["rod", "--method", method, "--paths", "100"];
+        args.extend(rod);
+        refused(&args, 1, &["collide", "--method exact"]);
+    }
+    let mut args = vec!["rod", "--method", "exact", "--json"];
+    args.extend(rod);
+    let (code, out, err) = geosens(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\"intensity\""), "{out}");
+    // Strongly absorbing, κe × length = 10⁴ (28 ms a path before): paths
+    // stop once their weight is exactly 0.
+    let (code, _, err) = geosens(&[
+        "rod",
+        "--method",
+        "expectation",
+        "--ks",
+        "5e5",
+        "--ke",
+        "1e6",
+        "--length",
+        "0.01",
+        "--x",
+        "0.005",
+        "--omega",
+        "1",
+        "--paths",
+        "10000",
+    ]);
+    assert_eq!(code, 0, "{err}");
+}

@@ -192,6 +192,7 @@ impl Problem for (Rod, Probe) {
     /// For [`Method::Fd`] the half step is `fd_step` times the rod's length.
     fn estimator(&self, method: Method, fd_step: Option<f64>) -> Result<Box<dyn Estimator>, Error> {
         let (rod, probe) = *self;
+        check_collisions(&rod)?;
         Ok(match method {
             Method::Intensity => Box::new(intensity::IntensityEstimator { rod, probe }),
             Method::Expectation => Box::new(expectation::ExpectationEstimator { rod, probe }),
@@ -204,6 +205,37 @@ impl Problem for (Rod, Probe) {
             )?),
         })
     }
+}
+
+/// Most collisions a rod's path is expected to need: beyond, a Monte Carlo
+/// run would not end in any useful time (the exact solution still serves).
+pub const MAX_COLLISIONS: f64 = 1e6;
+
+/// Refuses Monte Carlo on a rod whose paths would need more than
+/// [`MAX_COLLISIONS`] collisions: about `(κs π̃)²` in a conservative rod
+/// (a random walk leaves a slab of optical thickness τ after ~τ² steps), and
+/// at most `746 κs/κa` where absorption ends a path (its weight `e^{−κa L}`
+/// is exactly 0 from `κa L = 746` on, and the walk stops there).
+fn check_collisions(rod: &Rod) -> Result<(), Error> {
+    let tau = rod.ks * rod.length;
+    let ka = rod.ka();
+    let walk = tau * tau;
+    let collisions = if ka > 0.0 {
+        walk.min(746.0 * rod.ks / ka)
+    } else {
+        walk
+    };
+    if collisions > MAX_COLLISIONS {
+        return Err(Error::Config(format!(
+            "a path in this rod (κs × length = {}, albedo {}) would collide ~{} times: \
+             Monte Carlo is refused beyond {MAX_COLLISIONS:e} (use --method exact, or \
+             a thinner or more absorbing rod)",
+            crate::error::Num(tau),
+            crate::error::Num(rod.albedo()),
+            crate::error::Num(collisions.round())
+        )));
+    }
+    Ok(())
 }
 
 /// Central differences in the length with common random numbers: `I` at
