@@ -3,8 +3,8 @@
 //! walks now connect to lamps by next-event estimation) and two corners
 //! seen in the same direction to within 10⁻⁹ rad (the corner's jump is now
 //! evaluated exactly at the corner, not by two rays at ±10⁻⁷ rad).
+use geosens::flat::cases as stability;
 use geosens::flat::exact::Reference;
-use geosens::flat::figures::stability;
 use geosens::flat::space::Plane;
 use geosens::flat::{Method, Motion, Parameter, Scene, Sensor, Shape, Surface};
 use geosens::path::intensity::PlainEstimator;

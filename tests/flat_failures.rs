@@ -3,8 +3,8 @@
 //! each beside a method that stays well behaved, against the analytic
 //! reference or finite differences. The book's "Where the methods fail"
 //! section shows the same numbers.
+use geosens::flat::cases as stability;
 use geosens::flat::exact::Reference;
-use geosens::flat::figures::stability;
 use geosens::flat::{Method, Scene};
 use geosens::{Estimate, Quantity, RunConfig, run};
 use std::sync::Arc;

@@ -3,6 +3,7 @@
 //! derives every estimator.
 pub mod boundaries;
 pub mod bvh;
+pub mod cases;
 pub mod corners;
 pub mod exact;
 #[cfg(feature = "figures")]

@@ -1,7 +1,7 @@
 //! Flatland behind the path core's traits: [`Plane`] implements
 //! [`Geometry`] (rays through the scene's casters, the lobes of
 //! [`lobe`](super::lobe), emitters drawn by length, the parameters'
-//! motions); its discontinuities ([`Boundaries`]: corners and the warp) are
+//! motions); its discontinuities ([`Boundaries`](crate::path::Boundaries): corners and the warp) are
 //! in [`boundaries`](super::boundaries). Book: chapter "Flatland: one
 //! deformation, three estimators", section "One path core".
 use super::geometry::{NO_SEGMENT, cross};

@@ -15,7 +15,7 @@
 //!   corners of opaque shapes; 3D: silhouette edges) and the expectation
 //!   method's warp built on them.
 //!
-//! The methods are [`Hooks`] the loop calls at its events, one file each,
+//! The methods are [`Hooks`](walk::Hooks) the loop calls at its events, one file each,
 //! beside their derivation in the book: [`intensity`] (no hooks: the loop
 //! alone), [`rendering`] (Leibniz and corner terms, double randomisation),
 //! [`expectation`] (stretched free paths and the warp), [`transport`]
