@@ -319,3 +319,32 @@ fn a_rod_whose_paths_would_never_end_is_refused_but_solved_exactly() {
     ]);
     assert_eq!(code, 0, "{err}");
 }
+
+#[test]
+fn a_probe_no_path_reaches_prints_no_infinite_z_and_is_unreliable() {
+    // At x = 1.9999 looking back no path of 20000 contributes: 0 ± 0, which
+    // the table used to call reliable with z = inf.
+    let (code, out, err) = geosens(&[
+        "rod",
+        "--method",
+        "expectation",
+        "--ks",
+        "2.1",
+        "--ke",
+        "3",
+        "--length",
+        "2",
+        "--x",
+        "1.9999",
+        "--omega",
+        "-1",
+        "--paths",
+        "20000",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!out.contains("inf"), "{out}");
+    let row = out.lines().find(|l| l.starts_with("∂I/∂length")).unwrap();
+    let cells: Vec<&str> = row.split_whitespace().collect();
+    // quantity, mean, stderr, n, nonzero, vov, max_share, reliable, exact, z
+    assert_eq!((cells[4], cells[7], cells[9]), ("0", "no", "-"), "{row}");
+}
