@@ -187,8 +187,8 @@ fn view_change(scene: &Scene, j: usize, h: f64, plus: &Scene, minus: &Scene) -> 
             "finite differences along {name:?}: the step moves shape {:?} by {} while it \
              passes {} from the sensor; try a smaller --fd-step",
             shape.name,
-            crate::error::Num(travel),
-            crate::error::Num(distance)
+            crate::error::Num(round4(travel)),
+            crate::error::Num(round4(distance))
         ));
     }
     (sensor_view(plus) != sensor_view(minus)).then(|| {
@@ -196,9 +196,14 @@ fn view_change(scene: &Scene, j: usize, h: f64, plus: &Scene, minus: &Scene) -> 
             "finite differences along {name:?}: the sensor's view (visible corners, their \
              order) differs between the scenes displaced by ±{}: the difference straddles a \
              change of visibility; try a smaller --fd-step",
-            crate::error::Num(h)
+            crate::error::Num(round4(h))
         )
     })
+}
+
+/// `x` to 4 significant digits, for messages.
+fn round4(x: f64) -> f64 {
+    format!("{x:.3e}").parse().unwrap_or(x)
 }
 
 /// What the sensor sees, up to continuous motion: the corners visible from

@@ -96,9 +96,14 @@ impl FdArgs {
         problem
             .estimator(method, self.fd_step)
             .map_err(|e| match e {
-                Error::Scene(msg) if msg.contains("displaced by") => {
+                Error::Scene(msg) => {
                     let file = path.map_or(String::new(), |p| format!("{}: ", p.display()));
-                    Error::Scene(format!("{file}{msg}; try a smaller --fd-step"))
+                    let hint = if msg.contains("displaced by") {
+                        "; try a smaller --fd-step"
+                    } else {
+                        ""
+                    };
+                    Error::Scene(format!("{file}{msg}{hint}"))
                 }
                 other => other,
             })

@@ -124,10 +124,13 @@ fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
 }
 
 /// Smallest and largest scene size accepted: within them every squared
-/// length and cross product the tracer forms is a normal float.
-pub const MIN_SIZE: f64 = 1e-100;
+/// length and cross product the tracer forms is a normal float, and so is
+/// the fourth power of a translation's weight (∝ 1/size) that the
+/// variance-of-the-variance diagnostic sums (beyond ~10^±75 it overflows and
+/// the reliability flag would read "no" on a right answer).
+pub const MIN_SIZE: f64 = 1e-60;
 /// See [`MIN_SIZE`].
-pub const MAX_SIZE: f64 = 1e100;
+pub const MAX_SIZE: f64 = 1e60;
 
 /// Checks shape `k`: its name (`repeated`: an earlier shape has it), its
 /// vertices, its surface and its medium.
