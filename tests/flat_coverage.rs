@@ -25,7 +25,7 @@
 //! runs of the scene's first parameter (independent across scenes).
 //!
 //! A run of 4000 paths fits in one of the runner's chunks; runs go in
-//! parallel (rayon, one thread each, results in index order): 4 × 10⁷
+//! parallel (rayon, one thread each, results in index order): 6.7 × 10⁷
 //! paths, about 30 s of CPU in release.
 use geosens::flat::exact::Reference;
 use geosens::flat::{Method, Motion, Scene, file};
