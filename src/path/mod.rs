@@ -35,7 +35,32 @@ use crate::rng::PathRng;
 use glam::{DVec2, DVec3};
 use std::ops::{Add, Mul, Neg, Sub};
 
-pub use crate::flat::scene::Surface;
+/// What happens to light arriving at a surface, in the plane as in space.
+/// (Flatland's scene files read and write it through their own file form.)
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Surface {
+    /// Two-sided Lambertian emitter of uniform radiance; absorbs what arrives.
+    Emitter {
+        /// Emitted radiance (≥ 0).
+        radiance: f64,
+    },
+    /// Black: absorbs everything.
+    Absorber,
+    /// Two-sided Lambertian reflector.
+    Reflector {
+        /// Albedo in `[0, 1]`.
+        albedo: f64,
+    },
+    /// An index-matched interface: the boundary of a medium.
+    Transparent,
+}
+
+impl Surface {
+    /// Whether the surface stops rays (all but [`Surface::Transparent`]).
+    pub fn is_opaque(&self) -> bool {
+        !matches!(self, Surface::Transparent)
+    }
+}
 
 /// The vector type of a scene's space: points, velocities, directions and a
 /// direction's velocity (a vector tangent to the circle or the sphere).

@@ -26,32 +26,9 @@ pub const MAX_OPTICAL_THICKNESS: f64 = 1e4;
 /// axes in 3D): 253.
 pub const MAX_PARAMETERS: usize = crate::path::deform::MAX_SLOTS - 3;
 
-/// What happens to light arriving at a shape's boundary.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(from = "repr::Surface", into = "repr::Surface")]
-pub enum Surface {
-    /// Two-sided Lambertian emitter of uniform radiance; absorbs what arrives.
-    Emitter {
-        /// Emitted radiance (≥ 0).
-        radiance: f64,
-    },
-    /// Black: absorbs everything.
-    Absorber,
-    /// Two-sided Lambertian reflector.
-    Reflector {
-        /// Albedo in `[0, 1]`.
-        albedo: f64,
-    },
-    /// An index-matched interface: the boundary of a medium.
-    Transparent,
-}
-
-impl Surface {
-    /// Whether the surface stops rays (all but [`Surface::Transparent`]).
-    pub fn is_opaque(&self) -> bool {
-        !matches!(self, Surface::Transparent)
-    }
-}
+/// What happens to light arriving at a shape's boundary: the path core's
+/// surfaces (serialised through the file form in `repr`).
+pub use crate::path::Surface;
 
 /// Angular distribution of scattering in a medium (normalised over the circle).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

@@ -137,3 +137,18 @@ impl From<super::Motion> for Motion {
         }
     }
 }
+
+/// The path core's [`Surface`](super::Surface) reads and writes through the
+/// file form (what `#[serde(from, into)]` would derive, written out because
+/// the type lives in `crate::path`).
+impl Serialize for super::Surface {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        Surface::from(*self).serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for super::Surface {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        Surface::deserialize(d).map(Into::into)
+    }
+}
