@@ -10,8 +10,9 @@
 //! `(u + ṫ_b ω + t_b ω̇ − v)·n = 0`, so
 //! `ṫ_b = (v − u − t_b ω̇)·n / (ω·n)` (book: "Flatland: one deformation,
 //! three estimators", *the hit point's velocity*), in the plane and in space.
-use super::walk::{Hooks, Vertex, light_sample, transmittance};
-use super::{Geometry, Hit, Vector};
+use super::rendering::Rendering;
+use super::walk::{Vertex, light_sample, transmittance};
+use super::{Boundaries, Geometry, Hit, Vector};
 use crate::rng::PathRng;
 
 /// Most derivative slots a walk carries (shape parameters plus the sensor's
@@ -388,40 +389,18 @@ impl<V: Vector> Scratch<V> {
     }
 }
 
-/// The hooks of a straight connection to an emitter: every slot's vertex
-/// follows the segments (the connection has no free path to stretch), its
-/// transmittance differentiated.
-struct Follow<'a, V: Vector> {
-    d: &'a mut Deform<V>,
-    slots: &'a Slots,
-    frozen: bool,
-}
-
-impl<G: Geometry> Hooks<G> for Follow<'_, G::V> {
-    #[inline]
-    fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
-        self.d.segment(g, self.slots, self.frozen, x, w, hit);
-    }
-    #[inline]
-    fn pass(&mut self, ke: f64) {
-        self.d.pass(self.slots.all(), ke);
-    }
-    #[inline]
-    fn arrive(&mut self, w: G::V, t: f64) {
-        self.d.arrive(self.slots.all(), w, t);
-    }
-}
-
 // ANCHOR: connect
 /// Next-event estimation at `v` for a derivative walk in state `d`: one
 /// emitter point drawn as the intensity estimator draws it; its direction
 /// `ω` deforms as `direction` sets it (the method's rule: the frame's turn,
 /// the warp), the connection's segments follow, and `contribution × score`
-/// is added to every slot. The MIS weight is a fixed partition of unity in
+/// is added to every slot. The connection's segments are followed by
+/// rendering's hooks (it has no free path, so only their boundary speed,
+/// transmittance and vertex carrying act). The MIS weight is a fixed partition of unity in
 /// the method's own coordinates over directions, so it is not
 /// differentiated (book: "Next-event estimation in the derivative walks").
 #[allow(clippy::too_many_arguments)]
-pub fn connect<G: Geometry>(
+pub fn connect<G: Boundaries>(
     g: &G,
     slots: &Slots,
     scratch: &mut Scratch<G::V>,
@@ -437,12 +416,16 @@ pub fn connect<G: Geometry>(
     let mut tmp = scratch.take(d.len());
     tmp.copy_from(d);
     direction(&mut tmp, w);
-    let mut follow = Follow {
-        d: &mut tmp,
+    let mut follow = Rendering {
         slots,
+        scratch,
+        d: tmp,
         frozen,
     };
     let contribution = c * transmittance(g, &mut follow, v.x, w, v.medium, v.skip, p);
+    let Rendering {
+        d: tmp, scratch, ..
+    } = follow;
     if contribution != 0.0 {
         for j in tmp.live.iter() {
             d.slots[j].boundary += contribution * tmp.slots[j].score;
