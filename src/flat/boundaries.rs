@@ -374,7 +374,7 @@ impl Plane {
     /// The neighbours of `w` among the sensor's knots (precomputed: the
     /// sensor does not move).
     fn sensor_knots(&self, w: DVec2, (h_ccw, h_cw): (f64, f64)) -> (Option<Knot>, Option<Knot>) {
-        let knots = &self.sensor_knots;
+        let knots = self.sensor_knot_list();
         if knots.is_empty() {
             return (None, None);
         }

@@ -213,21 +213,10 @@ fn sensor_view(scene: &Scene) -> Vec<u32> {
     use super::Sensor;
     use super::geometry::NO_SEGMENT;
     match scene.sensor() {
-        Sensor::Irradiance { point, normal } => {
-            let mut seen: Vec<(f64, u32)> = scene
-                .corners()
-                .iter()
-                .enumerate()
-                .filter(|(_, (q, _))| (*q - point).dot(normal) > 0.0)
-                .filter(|(_, (q, _))| scene.visible(point, *q, NO_SEGMENT))
-                .map(|(i, (q, _))| {
-                    let r = *q - point;
-                    (r.y.atan2(r.x), i as u32)
-                })
-                .collect();
-            seen.sort_by(|a, b| a.0.total_cmp(&b.0));
-            seen.into_iter().map(|s| s.1).collect()
-        }
+        Sensor::Irradiance { .. } => super::space::sensor_corners(scene)
+            .into_iter()
+            .map(|(_, i)| i as u32)
+            .collect(),
         Sensor::Radiance { point, direction } => scene
             .opaque_hit(point, direction, NO_SEGMENT)
             .map(|h| h.2)

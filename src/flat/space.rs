@@ -12,7 +12,7 @@ use crate::rng::PathRng;
 use glam::DVec2;
 use rand::RngExt;
 use std::f64::consts::PI;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// A flatland scene with the tables the derivative methods need.
 #[derive(Debug, Clone)]
@@ -32,8 +32,9 @@ pub struct Plane {
     pub(super) all_cdf: Vec<f64>,
     pub(super) moving_cdf: Vec<f64>,
     /// The corners visible from an irradiance sensor in front of it, by
-    /// angle from +x: the warp's knots there, the same for every path.
-    pub(super) sensor_knots: Vec<Knot>,
+    /// angle from +x: the warp's knots there, the same for every path
+    /// (found on first use: only the expectation method asks).
+    sensor_knots: OnceLock<Vec<Knot>>,
 }
 
 /// A knot of the warp: angle from the sampled direction, corner, shape.
@@ -71,17 +72,6 @@ impl Plane {
             .filter(|(_, c)| moving(c.1))
             .map(|(i, _)| i as u32)
             .collect();
-        let mut sensor_knots: Vec<Knot> = match scene.sensor() {
-            FlatSensor::Irradiance { point, normal } => scene
-                .corners()
-                .iter()
-                .filter(|&&(q, _)| (q - point).dot(normal) > 0.0)
-                .filter(|&&(q, _)| scene.visible(point, q, NO_SEGMENT))
-                .map(|&(q, k)| ((q - point).y.atan2((q - point).x), q, k))
-                .collect(),
-            FlatSensor::Radiance { .. } => Vec::new(),
-        };
-        sensor_knots.sort_by(|a, b| a.0.total_cmp(&b.0));
         let segments = scene.segments();
         // ANCHOR: corner_weight
         let corner_weight: Vec<f64> = corner_segments
@@ -113,7 +103,7 @@ impl Plane {
             corner_weight,
             all_cdf,
             moving_cdf,
-            sensor_knots,
+            sensor_knots: OnceLock::new(),
         }
     }
 
@@ -121,6 +111,38 @@ impl Plane {
     pub fn scene(&self) -> &Arc<Scene> {
         &self.scene
     }
+
+    /// The warp's knots at an irradiance sensor (see the field).
+    pub(super) fn sensor_knot_list(&self) -> &[Knot] {
+        self.sensor_knots.get_or_init(|| {
+            let corners = self.scene.corners();
+            sensor_corners(&self.scene)
+                .into_iter()
+                .map(|(angle, i)| (angle, corners[i].0, corners[i].1))
+                .collect()
+        })
+    }
+}
+
+/// The corners an irradiance sensor sees in front of it, by angle from +x:
+/// `(angle, index into scene.corners())`; none for a radiance sensor.
+pub(super) fn sensor_corners(scene: &Scene) -> Vec<(f64, usize)> {
+    let FlatSensor::Irradiance { point, normal } = scene.sensor() else {
+        return Vec::new();
+    };
+    let mut seen: Vec<(f64, usize)> = scene
+        .corners()
+        .iter()
+        .enumerate()
+        .filter(|(_, (q, _))| (*q - point).dot(normal) > 0.0)
+        .filter(|(_, (q, _))| scene.visible(point, *q, NO_SEGMENT))
+        .map(|(i, (q, _))| {
+            let r = *q - point;
+            (r.y.atan2(r.x), i)
+        })
+        .collect();
+    seen.sort_by(|a, b| a.0.total_cmp(&b.0));
+    seen
 }
 
 impl Geometry for Plane {
