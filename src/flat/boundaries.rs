@@ -73,11 +73,7 @@ impl Boundaries for Plane {
                 continue;
             }
             let seg = segments[s as usize];
-            let other = if (seg.a - b.q).length_squared() < (seg.b - b.q).length_squared() {
-                seg.b
-            } else {
-                seg.a
-            };
+            let other = far_end(&seg, b.q);
             let d = other - b.q;
             let c = cross(w, d);
             if c == 0.0 {
@@ -120,11 +116,7 @@ impl Boundaries for Plane {
     #[inline]
     fn off_boundary(&self, b: &BoundaryPoint<DVec2>, p: u32) -> DVec2 {
         let seg = self.scene.segments()[p as usize];
-        let other = if (seg.a - b.q).length_squared() < (seg.b - b.q).length_squared() {
-            seg.b
-        } else {
-            seg.a
-        };
+        let other = far_end(&seg, b.q);
         let along = other - b.q;
         let step = (1e-9 * self.scene.size()).min(0.5 * along.length());
         b.q + along.normalize() * step
@@ -394,6 +386,16 @@ impl Plane {
             (b_angle < h_ccw).then_some((b_angle, b.1, b.2)),
             (a_angle < h_cw && a_angle > 0.0).then_some((a_angle, a.1, a.2)),
         )
+    }
+}
+
+/// The end of `seg` that is not its corner `q`.
+#[inline]
+fn far_end(seg: &super::geometry::Segment, q: DVec2) -> DVec2 {
+    if (seg.a - q).length_squared() < (seg.b - q).length_squared() {
+        seg.b
+    } else {
+        seg.a
     }
 }
 
