@@ -51,6 +51,7 @@ pub mod error;
 pub mod estimator;
 pub mod fd;
 pub mod flat;
+pub mod mesh;
 pub mod method;
 pub mod path;
 #[cfg(feature = "figures")]

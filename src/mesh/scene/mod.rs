@@ -1,0 +1,244 @@
+//! A 3D scene: triangle meshes with a surface and optionally a homogeneous
+//! medium inside (closed meshes only), the shape parameters whose
+//! sensitivities are wanted, and the sensor. [`Scene::new`] welds each mesh
+//! by position and validates everything a user can get wrong (the book's 3D
+//! chapter lists the rules), so the path tracer never meets a degenerate
+//! configuration.
+//!
+//! This file holds the data types and the validated [`Scene`] with its
+//! accessors; `validate` builds a scene step by step.
+use crate::error::Error;
+use glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+
+mod validate;
+
+/// What happens to light arriving at a mesh: the path core's surfaces, read
+/// and written in the same file form as flatland's.
+pub use crate::path::Surface;
+
+/// A homogeneous medium filling a closed mesh, with a Henyey–Greenstein
+/// phase function (`g = 0`: isotropic).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Medium {
+    /// Scattering coefficient κs ≥ 0.
+    pub ks: f64,
+    /// Extinction coefficient κe ≥ κs.
+    pub ke: f64,
+    /// Mean cosine of the Henyey–Greenstein phase function, `|g| < 1`.
+    #[serde(default)]
+    pub g: f64,
+}
+
+/// A triangle mesh (after [`Scene::new`]: welded by position, every
+/// triangle non-degenerate).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shape {
+    /// Unique name, used by parameters.
+    pub name: String,
+    /// Vertex positions.
+    pub vertices: Vec<DVec3>,
+    /// Triangles as indices into `vertices`, counter-clockwise seen from
+    /// outside for a closed mesh (its normals point out).
+    pub triangles: Vec<[u32; 3]>,
+    /// The surface's behaviour (two-sided).
+    pub surface: Surface,
+    /// The medium inside (closed, transparent meshes only).
+    pub medium: Option<Medium>,
+}
+
+impl Shape {
+    /// The corners of triangle `i`.
+    #[inline]
+    pub fn triangle(&self, i: usize) -> [DVec3; 3] {
+        self.triangles[i].map(|v| self.vertices[v as usize])
+    }
+
+    /// Mean of the vertices: the default pivot.
+    pub fn centroid(&self) -> DVec3 {
+        self.vertices.iter().sum::<DVec3>() / self.vertices.len().max(1) as f64
+    }
+}
+
+/// How a parameter moves its mesh (with its medium).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Motion {
+    /// Translation along x (π = offset, nominal 0).
+    TranslateX,
+    /// Translation along y (π = offset, nominal 0).
+    TranslateY,
+    /// Translation along z (π = offset, nominal 0).
+    TranslateZ,
+    /// Rotation about the line through `pivot` along `axis` (π = angle in
+    /// radians, right-handed about `axis`, nominal 0).
+    Rotate {
+        /// Unit axis (normalised on validation).
+        axis: DVec3,
+        /// A point of the axis; the mesh's centroid if absent.
+        pivot: Option<DVec3>,
+    },
+    /// Uniform scale about a pivot (π = factor − 1, nominal 0).
+    Scale {
+        /// Pivot; the mesh's centroid if absent.
+        pivot: Option<DVec3>,
+    },
+}
+
+impl Motion {
+    /// Velocity `∂q/∂π` of the mesh point `q` (pivots resolved).
+    #[inline]
+    pub fn velocity(&self, q: DVec3) -> DVec3 {
+        match *self {
+            Motion::TranslateX => DVec3::X,
+            Motion::TranslateY => DVec3::Y,
+            Motion::TranslateZ => DVec3::Z,
+            Motion::Rotate { axis, pivot } => axis.cross(q - pivot.unwrap_or(DVec3::ZERO)),
+            Motion::Scale { pivot } => q - pivot.unwrap_or(DVec3::ZERO),
+        }
+    }
+
+    /// Angular velocity `∂Ω/∂π` of the mesh's frame (its normals turn as
+    /// `Ω × n`).
+    #[inline]
+    pub fn spin(&self) -> DVec3 {
+        match *self {
+            Motion::Rotate { axis, .. } => axis,
+            _ => DVec3::ZERO,
+        }
+    }
+
+    /// The point `q` moved by the finite parameter change `delta`.
+    pub fn apply(&self, q: DVec3, delta: f64) -> DVec3 {
+        match *self {
+            Motion::TranslateX => q + DVec3::new(delta, 0.0, 0.0),
+            Motion::TranslateY => q + DVec3::new(0.0, delta, 0.0),
+            Motion::TranslateZ => q + DVec3::new(0.0, 0.0, delta),
+            Motion::Rotate { axis, pivot } => {
+                let c = pivot.unwrap_or(DVec3::ZERO);
+                c + DQuat::from_axis_angle(axis.normalize(), delta) * (q - c)
+            }
+            Motion::Scale { pivot } => {
+                let c = pivot.unwrap_or(DVec3::ZERO);
+                c + (1.0 + delta) * (q - c)
+            }
+        }
+    }
+}
+
+/// A shape parameter π whose sensitivity `∂I/∂π` is estimated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    /// Unique name (the key of its sensitivity).
+    pub name: String,
+    /// Name of the mesh it moves.
+    pub shape: String,
+    /// How it moves it.
+    pub motion: Motion,
+}
+
+/// What is measured, at a static point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sensor {
+    /// Radiance arriving at `point` from `direction` (the direction the
+    /// sensor looks toward; unit after validation).
+    Radiance {
+        /// Where.
+        point: DVec3,
+        /// Looking direction.
+        direction: DVec3,
+    },
+    /// Irradiance `E = ∫ L(ω) (ω·n)⁺ dω` at `point` with unit normal `n`.
+    Irradiance {
+        /// Where.
+        point: DVec3,
+        /// Normal (unit after validation).
+        normal: DVec3,
+    },
+}
+
+impl Sensor {
+    /// The sensor's point.
+    pub fn point(&self) -> DVec3 {
+        match *self {
+            Sensor::Radiance { point, .. } | Sensor::Irradiance { point, .. } => point,
+        }
+    }
+}
+
+/// A validated scene: welded meshes, resolved parameters, medium nesting.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    shapes: Vec<Shape>,
+    parameters: Vec<Parameter>,
+    /// Shape index of each parameter.
+    parameter_shape: Vec<u32>,
+    sensor: Sensor,
+    /// Per shape, whether its mesh is closed (every edge shared by exactly
+    /// two triangles with opposite orientations).
+    closed: Vec<bool>,
+    /// For each shape, the medium shape around it (innermost enclosing
+    /// closed mesh with a medium), if any.
+    parent: Vec<Option<u32>>,
+    sensor_medium: Option<u32>,
+    size: f64,
+}
+
+impl Scene {
+    /// The same scene with parameter `j` changed by `delta` (its mesh
+    /// moved), validated again.
+    pub fn displaced(&self, j: usize, delta: f64) -> Result<Scene, Error> {
+        let Some(p) = self.parameters.get(j) else {
+            return Err(Error::Scene(format!("no parameter {j}")));
+        };
+        if !delta.is_finite() {
+            return Err(Error::Scene(format!("displacement {delta} is not finite")));
+        }
+        let mut shapes = self.shapes.clone();
+        let k = self.parameter_shape[j] as usize;
+        for v in &mut shapes[k].vertices {
+            *v = p.motion.apply(*v, delta);
+        }
+        Scene::new(shapes, self.parameters.clone(), self.sensor)
+    }
+
+    /// The meshes, welded.
+    pub fn shapes(&self) -> &[Shape] {
+        &self.shapes
+    }
+    /// The parameters, pivots resolved and axes normalised.
+    pub fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+    /// Shape index moved by parameter `j`.
+    #[inline]
+    pub fn parameter_shape(&self, j: usize) -> u32 {
+        self.parameter_shape[j]
+    }
+    /// The sensor (its direction or normal normalised).
+    pub fn sensor(&self) -> Sensor {
+        self.sensor
+    }
+    /// Whether shape `k`'s mesh is closed.
+    pub fn is_closed(&self, k: u32) -> bool {
+        self.closed[k as usize]
+    }
+    /// Largest extent of the scene's bounding box.
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+    /// The medium shape enclosing shape `k`.
+    #[inline]
+    pub fn parent_medium(&self, k: u32) -> Option<u32> {
+        self.parent[k as usize]
+    }
+    /// The medium shape around the sensor.
+    pub fn sensor_medium(&self) -> Option<u32> {
+        self.sensor_medium
+    }
+    /// The medium of shape `k`, if any.
+    #[inline]
+    pub fn medium(&self, k: Option<u32>) -> Option<&Medium> {
+        k.and_then(|k| self.shapes[k as usize].medium.as_ref())
+    }
+}
