@@ -5,3 +5,10 @@
 pub mod scene;
 
 pub use scene::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
+pub mod boundaries;
+pub mod lobe;
+pub mod methods;
+pub mod space;
+mod tris;
+
+pub use space::Space;

@@ -84,6 +84,10 @@ pub trait Vector:
     const STILL: Self::Spin;
     /// Number of coordinates.
     const DIM: usize;
+    /// `1 / ∫ (ω·n)⁺ dω` over the directions: a Lambertian reflector of
+    /// albedo ρ has the lobe `ρ · LAMBERT · (ω·n)⁺` (1/2 in the plane, 1/π
+    /// in space).
+    const LAMBERT: f64;
     /// The unit vector along coordinate axis `i`.
     fn axis(i: usize) -> Self;
     /// Scalar product.
@@ -103,6 +107,7 @@ impl Vector for DVec2 {
     type Spin = f64;
     const STILL: f64 = 0.0;
     const DIM: usize = 2;
+    const LAMBERT: f64 = 0.5;
     #[inline]
     fn axis(i: usize) -> Self {
         [DVec2::X, DVec2::Y][i]
@@ -130,6 +135,7 @@ impl Vector for DVec3 {
     type Spin = DVec3;
     const STILL: DVec3 = DVec3::ZERO;
     const DIM: usize = 3;
+    const LAMBERT: f64 = std::f64::consts::FRAC_1_PI;
     #[inline]
     fn axis(i: usize) -> Self {
         [DVec3::X, DVec3::Y, DVec3::Z][i]

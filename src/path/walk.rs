@@ -170,7 +170,7 @@ pub fn survives(depth: u32, beta: &mut f64, rng: &mut PathRng) -> bool {
 pub fn reflector_lobe<G: Geometry>(g: &G, p: Prim, y: G::V, w: G::V, albedo: f64) -> G::Lobe {
     let n = g.normal(p, y);
     let n = if w.dot(n) > 0.0 { -n } else { n };
-    g.cosine_lobe(n, 0.5 * albedo)
+    g.cosine_lobe(n, albedo * <G::V as Vector>::LAMBERT)
 }
 
 /// The emitter point drawn for next-event estimation at `v`: the direction

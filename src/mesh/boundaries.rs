@@ -1,0 +1,146 @@
+//! 3D discontinuities behind the path core's [`Boundaries`]: the edges of
+//! opaque meshes. Seen from a point `x`, an edge projects to an arc on the
+//! sphere of directions across which the integrand can jump: a silhouette
+//! (one side sees a face, the other sees past it), an open edge, or a
+//! crease (each side sees another face: a jump for a reflector only).
+//!
+//! The boundary term of the directional integral is a line integral along
+//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`. An edge is drawn with
+//! probability proportional to its weight (length × dihedral turn / π, a
+//! binary search in the cumulative weights), a point uniformly along it
+//! (the same uniform number, rescaled), and the arc-length Jacobian
+//! `dl/ds = |ω × ê| / r` goes into the inverse density, so the path core's
+//! corner term (`rendering::corner_jump`) is, unchanged, the edge term.
+//! Book: chapter "Three dimensions", section "Silhouette edges".
+use super::space::Space;
+use crate::path::walk::Vertex;
+use crate::path::{Boundaries, BoundaryPoint, NO_PRIM, Prim, Side};
+use glam::DVec3;
+
+impl Space {
+    /// The unit vector in the plane of face `p`, perpendicular to the edge
+    /// `e`, pointing from the edge into the face.
+    #[inline]
+    fn face_inward(&self, e: usize, p: Prim) -> DVec3 {
+        let edge = &self.edges[e];
+        let t = &self.tris[p as usize];
+        let along = (edge.b - edge.a).normalize();
+        // The face's vertex off the edge: the one farthest from its line.
+        let off = t
+            .iter()
+            .map(|&c| {
+                let r = c - edge.a;
+                r - along * r.dot(along)
+            })
+            .max_by(|u, v| u.length_squared().total_cmp(&v.length_squared()))
+            .unwrap_or(DVec3::ZERO);
+        off.normalize_or_zero()
+    }
+}
+
+impl Boundaries for Space {
+    /// An edge drawn with probability proportional to its weight, a point
+    /// uniformly along it; `inv_pdf` is per unit arc length on the sphere
+    /// seen from `x`.
+    #[inline]
+    fn sample_boundary(&self, x: DVec3, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
+        let cdf = if all { &self.all_cdf } else { &self.moving_cdf };
+        let total = *cdf.last()?;
+        if total <= 0.0 {
+            return None;
+        }
+        let s = (u * total).min(total * (1.0 - f64::EPSILON));
+        let pick = cdf.partition_point(|&c| c <= s).min(cdf.len() - 1);
+        let index = if all {
+            pick as u32
+        } else {
+            self.moving_edges[pick]
+        };
+        let weight = self.edge_weight[index as usize];
+        let before = if pick == 0 { 0.0 } else { cdf[pick - 1] };
+        // The remainder of the uniform number within the edge's share is
+        // uniform again: the point along the edge.
+        let along = ((s - before) / weight).clamp(0.0, 1.0);
+        let edge = &self.edges[index as usize];
+        let d = edge.b - edge.a;
+        let q = edge.a + d * along;
+        let r = q - x;
+        let dist = r.length();
+        let len = d.length();
+        // dl = |ω × ê| / r ds on the sphere.
+        let jacobian = (r / dist).cross(d / len).length() / dist;
+        if jacobian.is_nan() || jacobian <= 0.0 || jacobian.is_infinite() {
+            return None;
+        }
+        Some(BoundaryPoint {
+            q,
+            shape: edge.shape,
+            index,
+            inv_pdf: total / weight * len * jacobian,
+        })
+    }
+
+    // ANCHOR: sides
+    /// The faces at the edge on either side of the sight line `ω` from `x`:
+    /// face `i` lies on the side its inward direction `d_i` (in its plane,
+    /// perpendicular to the edge) points to across the line, `sign(d_i·n)`
+    /// for the arc's normal `n`; on each side the ray just past the line
+    /// meets the face with the least `(d_i·ω)/|d_i·n|` first, or none.
+    fn sides(&self, x: DVec3, b: &BoundaryPoint<DVec3>) -> (Side, Side) {
+        let w = (b.q - x).normalize();
+        let n = self.boundary_normal(x, b);
+        let e = b.index as usize;
+        let (mut ahead, mut behind) = ((f64::INFINITY, Side::Past), (f64::INFINITY, Side::Past));
+        for p in self.edges[e].faces {
+            if p == NO_PRIM {
+                continue;
+            }
+            let d = self.face_inward(e, p);
+            let c = d.dot(n);
+            if c == 0.0 {
+                continue; // seen edge-on: a grazing ray sees none of it
+            }
+            let order = d.dot(w) / c.abs();
+            let side = if c > 0.0 { &mut ahead } else { &mut behind };
+            if order < side.0 {
+                *side = (order, Side::Surface(p));
+            }
+        }
+        (ahead.1, behind.1)
+    }
+    // ANCHOR_END: sides
+
+    /// `ω × ê / |ω × ê|`: normal to the edge's arc on the sphere at `ω`.
+    #[inline]
+    fn boundary_normal(&self, x: DVec3, b: &BoundaryPoint<DVec3>) -> DVec3 {
+        let edge = &self.edges[b.index as usize];
+        let w = (b.q - x).normalize();
+        w.cross(edge.b - edge.a).normalize_or_zero()
+    }
+
+    #[inline]
+    fn off_boundary(&self, b: &BoundaryPoint<DVec3>, p: Prim) -> DVec3 {
+        let d = self.face_inward(b.index as usize, p);
+        b.q + d * (1e-9 * self.scene.size())
+    }
+
+    /// No warp in 3D yet: the expectation method is refused on 3D scenes
+    /// (see [`crate::mesh::methods`]).
+    type Warp = ();
+
+    fn warp(&self, _v: &Vertex<Self>, _w: DVec3) {}
+
+    fn warp_shapes(&self, _warp: &(), _f: impl FnMut(u32)) {}
+
+    fn warp_velocity(
+        &self,
+        _warp: &(),
+        _x: DVec3,
+        w: DVec3,
+        _u: DVec3,
+        spin: DVec3,
+        _velocity: impl Fn(DVec3, u32) -> DVec3,
+    ) -> (DVec3, f64) {
+        (spin.cross(w), 0.0)
+    }
+}

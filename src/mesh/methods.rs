@@ -1,0 +1,178 @@
+//! The 3D estimators behind the crate's [`Estimator`] interface, the same
+//! path core as flatland's ([`crate::path`]) over [`Space`]:
+//!
+//! - [`Method::Intensity`]: backward path tracing with next-event
+//!   estimation and MIS, free-path sampling in media;
+//! - [`Method::Rendering`]: interior derivative, Leibniz terms at moving
+//!   medium boundaries, and edge terms (silhouettes, open edges, creases)
+//!   seen from every path vertex and every lamp connection, double
+//!   randomised, the jump evaluated exactly at the edge;
+//! - [`Method::Transport`]: the coupled models of `s` and `∇I` with sources
+//!   on the moving boundaries; it also returns `∂I/∂x`, `∂I/∂y`, `∂I/∂z` at
+//!   the sensor;
+//! - [`Method::Fd`]: central differences with common random numbers, one
+//!   pair of displaced scenes per parameter.
+//!
+//! [`Method::Expectation`] needs a continuous warp of the sphere of
+//! directions that follows every moving silhouette; it is not built for 3D
+//! yet and is refused with a clear error.
+use super::scene::{Motion, Scene};
+use super::space::Space;
+use crate::error::Error;
+use crate::estimator::{Estimator, Quantity};
+use crate::fd::{CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement};
+use crate::method::{Method, Problem};
+use crate::path::deform::Slots;
+use crate::path::estimator::{DerivativeEstimator, Scheme};
+use crate::path::intensity::IntensityEstimator;
+use std::sync::Arc;
+
+impl Problem for Arc<Scene> {
+    /// For [`Method::Fd`] the half step is `fd_step` times the scene's size
+    /// for a translation, `fd_step` radians for a rotation and `fd_step` for
+    /// a scale.
+    fn estimator(&self, method: Method, fd_step: Option<f64>) -> Result<Box<dyn Estimator>, Error> {
+        let scene = Arc::clone(self);
+        let scheme = match method {
+            Method::Intensity => {
+                return Ok(Box::new(IntensityEstimator {
+                    geometry: Space::new(scene),
+                }));
+            }
+            Method::Fd => {
+                let step = fd_step.map_or(Ok(DEFAULT_STEP), check_step)?;
+                return Ok(Box::new(finite_difference(&scene, step)?));
+            }
+            Method::Expectation => {
+                return Err(Error::Config(
+                    "the expectation method is not available on 3D scenes yet (it needs a \
+                     continuous warp of the sphere of directions that follows every moving \
+                     silhouette); use rendering, transport or fd"
+                        .into(),
+                ));
+            }
+            Method::Rendering => Scheme::Rendering,
+            Method::Transport => Scheme::Transport,
+        };
+        Ok(Box::new(derivative(scene, scheme)))
+    }
+}
+
+/// The derivative estimator of `scheme` on `scene`.
+pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Space> {
+    let gradient = scheme == Scheme::Transport;
+    let mut names: Vec<Quantity> = scene
+        .parameters()
+        .iter()
+        .map(|p| Quantity::sensitivity(&p.name))
+        .collect();
+    if gradient {
+        for axis in ["x", "y", "z"] {
+            names.push(Quantity::gradient(axis));
+        }
+    }
+    let shapes = scene.shapes().len();
+    let geometry = Space::new(scene);
+    let slots = Slots::new(&geometry, shapes, gradient);
+    DerivativeEstimator {
+        geometry,
+        slots,
+        scheme,
+        names,
+    }
+}
+
+/// Central differences with common random numbers: `I` on the nominal
+/// scene, then per parameter `j` the readings of the scene displaced by
+/// `±h_j` (`h_j = step` × the scene's size for a translation, `step` for a
+/// rotation or a scale). Errors if a displaced scene is invalid (meshes
+/// crossing): the error names the parameter and the displacement. A step
+/// that moves the mesh by half its distance to the sensor or more is
+/// flagged as a caveat.
+pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDifference, Error> {
+    let step = crate::error::check("h", step, step > 0.0, "a finite number > 0")?;
+    let mut caveats = Vec::new();
+    let mut pairs = Vec::new();
+    for (j, p) in scene.parameters().iter().enumerate() {
+        let (h, note) = match p.motion {
+            Motion::TranslateX | Motion::TranslateY | Motion::TranslateZ => (
+                step * scene.size(),
+                format!(" (half step {step} × scene size {})", scene.size()),
+            ),
+            _ => (step, String::new()),
+        };
+        let displaced = |delta: f64| -> Result<Arc<Scene>, Error> {
+            scene
+                .displaced(j, delta)
+                .map(Arc::new)
+                .map_err(|e| invalid_displacement("scene", &p.name, delta, &note, e))
+        };
+        let (plus, minus) = (displaced(h)?, displaced(-h)?);
+        if let Some(c) = passes_sensor(scene, j, h) {
+            caveats.push((p.name.clone(), c));
+        }
+        pairs.push(Pair {
+            parameter: p.name.clone(),
+            plus: Method::Intensity.estimator(plus)?,
+            minus: Method::Intensity.estimator(minus)?,
+            half_step: h,
+        });
+    }
+    let mut fd =
+        CentralDifference::new(Some(Method::Intensity.estimator(Arc::clone(scene))?), pairs)?;
+    for (parameter, why) in caveats {
+        fd = fd.with_caveat(&parameter, why);
+    }
+    Ok(fd)
+}
+
+/// Why the central difference along parameter `j` (half step `h`) may not
+/// estimate the derivative: the step moves the mesh by half its distance to
+/// the sensor or more.
+fn passes_sensor(scene: &Scene, j: usize, h: f64) -> Option<String> {
+    let p = &scene.parameters()[j];
+    let shape = &scene.shapes()[scene.parameter_shape(j) as usize];
+    let x = scene.sensor().point();
+    let travel = shape
+        .vertices
+        .iter()
+        .map(|&q| (p.motion.apply(q, h) - q).length())
+        .fold(0.0, f64::max);
+    let distance = (0..shape.triangles.len())
+        .map(|i| point_triangle_distance(x, &shape.triangle(i)))
+        .fold(f64::INFINITY, f64::min);
+    (travel >= 0.5 * distance).then(|| {
+        format!(
+            "finite differences along {:?}: the step moves mesh {:?} by {} while it passes {} \
+             from the sensor; try a smaller --fd-step",
+            p.name,
+            shape.name,
+            crate::error::Num(travel),
+            crate::error::Num(distance)
+        )
+    })
+}
+
+/// Distance from `p` to the triangle `t`.
+pub fn point_triangle_distance(p: glam::DVec3, t: &[glam::DVec3; 3]) -> f64 {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    let nn = n.length_squared();
+    if nn > 0.0 {
+        // Inside the prism over the triangle: the distance to its plane.
+        let inside = (0..3).all(|i| {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            (b - a).cross(p - a).dot(n) >= 0.0
+        });
+        if inside {
+            return (p - t[0]).dot(n).abs() / nn.sqrt();
+        }
+    }
+    (0..3)
+        .map(|i| {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            let d = b - a;
+            let s = ((p - a).dot(d) / d.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+            (p - (a + d * s)).length()
+        })
+        .fold(f64::INFINITY, f64::min)
+}

@@ -1,0 +1,316 @@
+//! 3D scenes behind the path core's traits: [`Space`] implements
+//! [`Geometry`] (rays through a triangle BVH, the lobes of
+//! [`lobe`](super::lobe), emitters drawn by area, the meshes' motions); its
+//! discontinuities (silhouette and crease edges,
+//! [`Boundaries`](crate::path::Boundaries)) are in
+//! [`boundaries`](super::boundaries). Book: chapter "Three dimensions".
+use super::lobe::SpaceLobe;
+use super::scene::{Scene, Sensor as SceneSensor};
+use super::tris::TriangleBvh;
+use crate::path::{Geometry, Hit, MediumId, NO_PRIM, Prim, Sensor, Surface};
+use crate::rng::PathRng;
+use glam::DVec3;
+use rand::RngExt;
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// An edge of an opaque mesh: where the integrand over directions seen from
+/// a point can jump (a silhouette, an open edge, or a crease between two
+/// faces of different normals).
+#[derive(Debug, Clone, Copy)]
+pub struct Edge {
+    /// Its end points.
+    pub a: DVec3,
+    /// Second end.
+    pub b: DVec3,
+    /// The triangles (global primitive indices) on it; the second is
+    /// [`NO_PRIM`] for an open edge.
+    pub faces: [Prim; 2],
+    /// The mesh it belongs to.
+    pub shape: u32,
+}
+
+/// A 3D scene with the tables the estimators need.
+#[derive(Debug, Clone)]
+pub struct Space {
+    pub(super) scene: Arc<Scene>,
+    /// Every triangle, meshes in order.
+    pub(super) tris: Vec<[DVec3; 3]>,
+    /// Mesh of each triangle.
+    pub(super) owner: Vec<u32>,
+    /// Unit normal of each triangle, outward for closed meshes.
+    pub(super) normals: Vec<DVec3>,
+    caster: TriangleBvh,
+    /// Opaque triangles only (visibility), the map from a triangle to its
+    /// index there.
+    opaque: TriangleBvh,
+    opaque_index: Vec<u32>,
+    /// Emitting triangles with their cumulative area, and the total.
+    emitters: Vec<(Prim, f64)>,
+    emitter_area: f64,
+    /// The edges of opaque meshes that can be discontinuities.
+    pub(super) edges: Vec<Edge>,
+    /// Per edge, the weight with which the boundary terms draw it: its
+    /// length times `θ/π` (θ the angle between its faces' normals; 1 for an
+    /// open edge): the share of viewpoints from which it is a silhouette.
+    pub(super) edge_weight: Vec<f64>,
+    /// Indices of the edges of moving meshes.
+    pub(super) moving_edges: Vec<u32>,
+    /// Cumulative weights over all edges, and over the moving ones.
+    pub(super) all_cdf: Vec<f64>,
+    pub(super) moving_cdf: Vec<f64>,
+}
+
+impl Space {
+    /// The tables of `scene`.
+    pub fn new(scene: Arc<Scene>) -> Space {
+        let mut tris = Vec::new();
+        let mut owner = Vec::new();
+        let mut normals = Vec::new();
+        let mut edges = Vec::new();
+        let mut edge_weight = Vec::new();
+        for (k, s) in scene.shapes().iter().enumerate() {
+            let first = tris.len() as u32;
+            for i in 0..s.triangles.len() {
+                let t = s.triangle(i);
+                tris.push(t);
+                owner.push(k as u32);
+                normals.push((t[1] - t[0]).cross(t[2] - t[0]).normalize());
+            }
+            if !s.surface.is_opaque() {
+                continue;
+            }
+            // Edges by their vertex pair, in first-seen order (deterministic).
+            let mut index: HashMap<(u32, u32), usize> = HashMap::new();
+            let mut pairs: Vec<((u32, u32), [Prim; 2])> = Vec::new();
+            for (i, t) in s.triangles.iter().enumerate() {
+                for e in 0..3 {
+                    let (a, b) = (t[e], t[(e + 1) % 3]);
+                    let key = (a.min(b), a.max(b));
+                    let p = first + i as u32;
+                    match index.get(&key) {
+                        Some(&m) => {
+                            if pairs[m].1[1] == NO_PRIM {
+                                pairs[m].1[1] = p;
+                            }
+                        }
+                        None => {
+                            index.insert(key, pairs.len());
+                            pairs.push((key, [p, NO_PRIM]));
+                        }
+                    }
+                }
+            }
+            for ((a, b), faces) in pairs {
+                let (a, b) = (s.vertices[a as usize], s.vertices[b as usize]);
+                let turn = if faces[1] == NO_PRIM {
+                    1.0
+                } else {
+                    let (n0, n1) = (normals[faces[0] as usize], normals[faces[1] as usize]);
+                    n0.cross(n1).length().atan2(n0.dot(n1)) / std::f64::consts::PI
+                };
+                let w = (b - a).length() * turn;
+                if w > 0.0 {
+                    edges.push(Edge {
+                        a,
+                        b,
+                        faces,
+                        shape: k as u32,
+                    });
+                    edge_weight.push(w);
+                }
+            }
+        }
+        let mut opaque_tris = Vec::new();
+        let opaque_index = (0..tris.len())
+            .map(|i| {
+                if scene.shapes()[owner[i] as usize].surface.is_opaque() {
+                    opaque_tris.push(tris[i]);
+                    (opaque_tris.len() - 1) as u32
+                } else {
+                    NO_PRIM
+                }
+            })
+            .collect();
+        let mut emitter_area = 0.0;
+        let emitters = (0..tris.len())
+            .filter(|&i| {
+                matches!(scene.shapes()[owner[i] as usize].surface, Surface::Emitter { radiance } if radiance > 0.0)
+            })
+            .map(|i| {
+                let t = tris[i];
+                emitter_area += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                (i as Prim, emitter_area)
+            })
+            .collect();
+        let params = scene.parameters().len();
+        let moving = |k: u32| (0..params).any(|j| scene.parameter_shape(j) == k);
+        let moving_edges: Vec<u32> = (0..edges.len() as u32)
+            .filter(|&i| moving(edges[i as usize].shape))
+            .collect();
+        let cdf = |ids: &mut dyn Iterator<Item = usize>| {
+            let mut total = 0.0;
+            ids.map(|i| {
+                total += edge_weight[i];
+                total
+            })
+            .collect::<Vec<f64>>()
+        };
+        let all_cdf = cdf(&mut (0..edges.len()));
+        let moving_cdf = cdf(&mut moving_edges.iter().map(|&i| i as usize));
+        Space {
+            caster: TriangleBvh::new(tris.clone()),
+            opaque: TriangleBvh::new(opaque_tris),
+            opaque_index,
+            scene,
+            tris,
+            owner,
+            normals,
+            emitters,
+            emitter_area,
+            edges,
+            edge_weight,
+            moving_edges,
+            all_cdf,
+            moving_cdf,
+        }
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// The edges that can be discontinuities.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// Total area of the emitters.
+    pub fn emitter_area(&self) -> f64 {
+        self.emitter_area
+    }
+}
+
+impl Geometry for Space {
+    type V = DVec3;
+    type Lobe = SpaceLobe;
+
+    #[inline]
+    fn size(&self) -> f64 {
+        self.scene.size()
+    }
+    #[inline]
+    fn sensor(&self) -> Sensor<DVec3> {
+        match self.scene.sensor() {
+            SceneSensor::Radiance { point, direction } => Sensor::Radiance { point, direction },
+            SceneSensor::Irradiance { point, normal } => Sensor::Irradiance { point, normal },
+        }
+    }
+    #[inline]
+    fn sensor_medium(&self) -> MediumId {
+        self.scene.sensor_medium()
+    }
+    #[inline]
+    fn cast(&self, x: DVec3, w: DVec3, skip: Prim) -> Option<Hit> {
+        self.caster
+            .closest_hit(x, w, f64::INFINITY, skip)
+            .map(|(t, prim)| Hit { t, prim })
+    }
+    #[inline]
+    fn visible(&self, x: DVec3, y: DVec3, skip: Prim) -> bool {
+        let d = y - x;
+        let len = d.length();
+        let skip = if skip == NO_PRIM {
+            NO_PRIM
+        } else {
+            self.opaque_index[skip as usize]
+        };
+        !self.opaque.any_hit(x, d / len, len * (1.0 - 1e-9), skip)
+    }
+    #[inline]
+    fn shape(&self, p: Prim) -> u32 {
+        self.owner[p as usize]
+    }
+    #[inline]
+    fn surface(&self, p: Prim) -> Surface {
+        self.scene.shapes()[self.owner[p as usize] as usize].surface
+    }
+    #[inline]
+    fn normal(&self, p: Prim, _y: DVec3) -> DVec3 {
+        self.normals[p as usize]
+    }
+    #[inline]
+    fn coefficients(&self, m: MediumId) -> Option<(f64, f64)> {
+        self.scene.medium(m).map(|m| (m.ks, m.ke))
+    }
+    #[inline]
+    fn crossed(&self, m: MediumId, k: u32) -> MediumId {
+        if m == Some(k) {
+            self.scene.parent_medium(k)
+        } else {
+            Some(k)
+        }
+    }
+    #[inline]
+    fn cosine_lobe(&self, n: DVec3, c: f64) -> SpaceLobe {
+        SpaceLobe::Cosine { n, c }
+    }
+    #[inline]
+    fn phase_lobe(&self, m: MediumId, w: DVec3) -> SpaceLobe {
+        SpaceLobe::Phase {
+            g: self.scene.medium(m).map_or(0.0, |m| m.g),
+            w_in: w,
+        }
+    }
+    /// A point drawn uniformly by area on the emitters: the triangle by a
+    /// binary search in the cumulative areas, the point by folding the unit
+    /// square.
+    #[inline]
+    fn emitter_point(&self, rng: &mut PathRng) -> Option<(DVec3, Prim)> {
+        let (&(_, total), _) = self.emitters.split_last()?;
+        let s = rng.random::<f64>() * total;
+        let i = self
+            .emitters
+            .partition_point(|e| e.1 <= s)
+            .min(self.emitters.len() - 1);
+        let p = self.emitters[i].0;
+        let t = &self.tris[p as usize];
+        let (r1, r2): (f64, f64) = (rng.random(), rng.random());
+        let (b0, b1) = if r1 + r2 > 1.0 {
+            (1.0 - r1, 1.0 - r2)
+        } else {
+            (r1, r2)
+        };
+        Some((t[0] + b0 * (t[1] - t[0]) + b1 * (t[2] - t[0]), p))
+    }
+    /// `r² / (|cos θ_e| A)` for a point drawn by area on emitters of total
+    /// area `A`.
+    #[inline]
+    fn light_pdf(&self, x: DVec3, y: DVec3, p: Prim) -> f64 {
+        let d = y - x;
+        let r2 = d.length_squared();
+        let c = (d / r2.sqrt()).dot(self.normals[p as usize]).abs();
+        if c > 0.0 {
+            r2 / (c * self.emitter_area)
+        } else {
+            f64::INFINITY
+        }
+    }
+    #[inline]
+    fn parameters(&self) -> usize {
+        self.scene.parameters().len()
+    }
+    #[inline]
+    fn parameter_shape(&self, j: usize) -> u32 {
+        self.scene.parameter_shape(j)
+    }
+    #[inline]
+    fn velocity(&self, j: usize, q: DVec3) -> DVec3 {
+        self.scene.parameters()[j].motion.velocity(q)
+    }
+    #[inline]
+    fn spin(&self, j: usize) -> DVec3 {
+        self.scene.parameters()[j].motion.spin()
+    }
+}
