@@ -13,6 +13,7 @@
 //! corner term (`rendering::corner_jump`) is, unchanged, the edge term.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
 use super::space::Space;
+use super::warp::SpaceWarp;
 use crate::path::walk::Vertex;
 use crate::path::{Boundaries, BoundaryPoint, NO_PRIM, Prim, Side};
 use glam::DVec3;
@@ -124,23 +125,26 @@ impl Boundaries for Space {
         b.q + d * (1e-9 * self.scene.size())
     }
 
-    /// No warp in 3D yet: the expectation method is refused on 3D scenes
-    /// (see [`crate::mesh::methods`]).
-    type Warp = ();
+    /// The fibre warp of [`super::warp`].
+    type Warp = SpaceWarp;
 
-    fn warp(&self, _v: &Vertex<Self>, _w: DVec3) {}
+    fn warp(&self, v: &Vertex<Self>, w: DVec3) -> SpaceWarp {
+        self.fibre_warp(v, w)
+    }
 
-    fn warp_shapes(&self, _warp: &(), _f: impl FnMut(u32)) {}
+    fn warp_shapes(&self, warp: &SpaceWarp, f: impl FnMut(u32)) {
+        self.fibre_shapes(warp, f)
+    }
 
     fn warp_velocity(
         &self,
-        _warp: &(),
-        _x: DVec3,
+        warp: &SpaceWarp,
+        x: DVec3,
         w: DVec3,
-        _u: DVec3,
+        u: DVec3,
         spin: DVec3,
-        _velocity: impl Fn(DVec3, u32) -> DVec3,
+        velocity: impl Fn(DVec3, u32) -> DVec3,
     ) -> (DVec3, f64) {
-        (spin.cross(w), 0.0)
+        self.fibre_velocity(warp, x, w, u, spin, velocity)
     }
 }

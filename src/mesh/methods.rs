@@ -43,14 +43,7 @@ impl Problem for Arc<Scene> {
                 let step = fd_step.map_or(Ok(DEFAULT_STEP), check_step)?;
                 return Ok(Box::new(finite_difference(&scene, step)?));
             }
-            Method::Expectation => {
-                return Err(Error::Config(
-                    "the expectation method is not available on 3D scenes yet (it needs a \
-                     continuous warp of the sphere of directions that follows every moving \
-                     silhouette); use rendering, transport or fd"
-                        .into(),
-                ));
-            }
+            Method::Expectation => Scheme::Expectation,
             Method::Rendering => Scheme::Rendering,
             Method::Transport => Scheme::Transport,
         };

@@ -232,14 +232,35 @@ pub(super) fn compare_command(
 
 /// `geosens flat`.
 pub(super) fn flat_command(
-    args: &FlatArgs,
+    args: &SceneArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let scene = std::sync::Arc::new(geosens::flat::file::load(&args.scene)?);
+    let (shapes, parameters) = (scene.shapes().len(), scene.parameters().len());
+    scene_command(args, scene, shapes, parameters, out)
+}
+
+/// `geosens mesh`.
+pub(super) fn mesh_command(
+    args: &SceneArgs,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let scene = std::sync::Arc::new(geosens::mesh::file::load(&args.scene)?);
+    let (shapes, parameters) = (scene.shapes().len(), scene.parameters().len());
+    scene_command(args, scene, shapes, parameters, out)
+}
+
+/// A run of `args.method` on a scene loaded from `args.scene` (`shapes`
+/// shapes, `parameters` parameters): a table or one JSON line.
+fn scene_command(
+    args: &SceneArgs,
+    problem: impl Problem,
+    shapes: usize,
+    parameters: usize,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
     let cfg = args.run.config(1_000_000)?;
-    let estimator = args
-        .fd
-        .estimator(args.method, scene.clone(), Some(&args.scene))?;
+    let estimator = args.fd.estimator(args.method, problem, Some(&args.scene))?;
     let result = run(estimator.as_ref(), &cfg)?;
     all_finite(&result)?;
     let caveats = estimator.caveats();
@@ -279,8 +300,8 @@ pub(super) fn flat_command(
         out,
         "scene {}: {} shapes, {} parameters",
         args.scene.display(),
-        scene.shapes().len(),
-        scene.parameters().len()
+        shapes,
+        parameters
     )?;
     writeln!(
         out,

@@ -7,6 +7,8 @@
 //! - `geosens flat --scene FILE --method M [--json]` does the same for every
 //!   parameter of a flatland scene file (`--fd-step H` sets the half step of
 //!   `--method fd`, on both subcommands);
+//! - `geosens mesh --scene FILE --method M [--json]`: the same for a 3D
+//!   triangle-mesh scene file (gradient axes x, y, z);
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
 //!   and thick rods at a few probes and prints them beside the exact solution,
 //!   then writes the rod's figures and flatland's (`flat_*`) (with the
@@ -46,13 +48,16 @@ enum Command {
     /// then write the rod's figures and flatland's.
     Compare(CompareArgs),
     /// Estimate I and ∂I/∂π for every parameter of a flatland scene file.
-    Flat(FlatArgs),
+    Flat(SceneArgs),
+    /// Estimate I and ∂I/∂π for every parameter of a 3D (triangle-mesh)
+    /// scene file; `transport` also gives ∂I/∂x, ∂I/∂y, ∂I/∂z.
+    Mesh(SceneArgs),
 }
 
-/// `geosens flat`: a scene file, a method, a run.
+/// `geosens flat` and `geosens mesh`: a scene file, a method, a run.
 #[derive(Debug, Args)]
-struct FlatArgs {
-    /// Scene file (TOML or JSON; see scenes/).
+struct SceneArgs {
+    /// Scene file (TOML or JSON; see scenes/ and scenes/mesh/).
     #[arg(long)]
     scene: std::path::PathBuf,
     /// Estimation method.
@@ -272,6 +277,7 @@ fn main() -> ExitCode {
         Command::Rod(args) => commands::rod_command(args, &mut out),
         Command::Compare(args) => commands::compare_command(args, &mut out),
         Command::Flat(args) => commands::flat_command(args, &mut out),
+        Command::Mesh(args) => commands::mesh_command(args, &mut out),
     };
     match result.and_then(|()| Ok(out.flush()?)) {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,272 @@
+//! The expectation method's warp on the sphere of directions: a family of
+//! flatland warps along half great circles ("fibres") from a pole `p` to
+//! `−p`.
+//!
+//! The field is `V(ω) = Ω × ω + α(ω) e_θ(ω)`: the frame's rotation `Ω`
+//! plus a component along the fibre (`e_θ`, the direction of growing polar
+//! angle θ from `p`). Along each fibre, `α` is piecewise linear in θ between
+//! *knots*: the poles and the lobe's horizon (where `α = 0`: they move with
+//! the frame) and the points where the fibre's plane (through the vertex
+//! `x`, `p` and `ω`) cuts a visible edge of an opaque mesh, with `α` the
+//! rate at which that crossing slides along the fibre when the edge moves
+//! relative to the frame. Only the knots nearest to ω on either side are
+//! needed, found by a scan of the edges and a shadow ray per candidate.
+//!
+//! Why this is a valid warp: the domain-deformation identity
+//! `d/dπ ∫ f = ∫ (∇f·V + f div V)` needs `V·n` to equal the normal velocity
+//! of every curve where `f` jumps, and `V·n` to be continuous elsewhere.
+//! Every visible discontinuity that a fibre crosses is a knot of that fibre,
+//! so `V·n` is right there. Where the set of knots changes from fibre to
+//! fibre (an edge ends, a crossing is hidden), `V` jumps *across a fibre*,
+//! but `V` is tangent to the fibres, so its normal component does not jump.
+//! The divergence on the unit sphere is `∂α/∂θ + α cot θ`.
+//!
+//! The pole is a pseudo-random direction fixed by the vertex's position, so
+//! no edge of a scene lies along the fibres by construction (an edge
+//! exactly on a fibre could not be moved by `V`; nearly on one, `α` is
+//! large: the method's heavy tail). Book: chapter "Three dimensions",
+//! section "A warp on the sphere".
+use super::space::Space;
+use crate::path::NO_PRIM;
+use crate::path::walk::Vertex;
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// A knot of a fibre: its polar angle and, for an edge crossing, the
+/// crossing point, the edge's direction and the mesh.
+#[derive(Debug, Clone, Copy)]
+pub struct FibreKnot {
+    /// Polar angle from the pole.
+    pub theta: f64,
+    /// The edge crossing, or `None` for a knot moving with the frame.
+    pub edge: Option<(DVec3, DVec3, u32)>,
+}
+
+/// The warp at a vertex around a sampled direction.
+#[derive(Debug, Clone, Copy)]
+pub struct SpaceWarp {
+    /// The pole.
+    p: DVec3,
+    /// Unit vector with `ω = cos θ p + sin θ u` (the fibre's plane).
+    u: DVec3,
+    /// The plane's unit normal `p × u`.
+    m: DVec3,
+    /// ω's polar angle.
+    theta: f64,
+    /// Nearest knots below and above θ.
+    lo: FibreKnot,
+    hi: FibreKnot,
+}
+
+/// A pseudo-random unit vector fixed by the bits of `x`.
+fn pole(x: DVec3) -> DVec3 {
+    let mut h: u64 = 0x9E37_79B9_7F4A_7C15;
+    for c in [x.x, x.y, x.z] {
+        h ^= (c + 0.0).to_bits();
+        h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        h ^= h >> 31;
+    }
+    let mut next = || {
+        h = h.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = h;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let z = 2.0 * next() - 1.0;
+    let phi = 2.0 * PI * next();
+    let s = (1.0 - z * z).max(0.0).sqrt();
+    DVec3::new(s * phi.cos(), s * phi.sin(), z)
+}
+
+impl Space {
+    /// The warp at `v` around `w`.
+    pub(super) fn fibre_warp(&self, v: &Vertex<Self>, w: DVec3) -> SpaceWarp {
+        let x = v.x;
+        let p = pole(x);
+        let c = w.dot(p).clamp(-1.0, 1.0);
+        let perp = w - p * c;
+        let s = perp.length();
+        let still = |t: f64| FibreKnot {
+            theta: t,
+            edge: None,
+        };
+        if s < 1e-12 {
+            // ω at a pole: the field is the frame's there.
+            let theta = c.acos();
+            return SpaceWarp {
+                p,
+                u: p.any_orthonormal_vector(),
+                m: DVec3::ZERO,
+                theta,
+                lo: still(theta),
+                hi: still(theta),
+            };
+        }
+        let u = perp / s;
+        let m = p.cross(u);
+        let theta = s.atan2(c);
+        // The lobe's horizon on the fibre (a knot moving with the frame):
+        // where cos θ (p·n) + sin θ (u·n) = 0.
+        let (mut lo, mut hi) = (still(0.0), still(PI));
+        if let crate::mesh::lobe::SpaceLobe::Cosine { n, .. } = v.lobe {
+            let (a, b) = (p.dot(n), u.dot(n));
+            // θ_h in (0, π) with a cos θ_h + b sin θ_h = 0.
+            let th = (-a).atan2(b).rem_euclid(PI);
+            if th > 0.0 && th < theta && th > lo.theta {
+                lo = still(th);
+            } else if th > theta && th < hi.theta {
+                hi = still(th);
+            }
+        }
+        let (lo, hi) = self.nearest_crossings(x, v.skip, p, u, m, theta, lo, hi);
+        SpaceWarp {
+            p,
+            u,
+            m,
+            theta,
+            lo,
+            hi,
+        }
+    }
+
+    /// The visible edge crossings of the fibre nearest to θ on either side,
+    /// within the knots `lo` and `hi` already found.
+    #[allow(clippy::too_many_arguments)]
+    fn nearest_crossings(
+        &self,
+        x: DVec3,
+        skip: u32,
+        p: DVec3,
+        u: DVec3,
+        m: DVec3,
+        theta: f64,
+        mut lo: FibreKnot,
+        mut hi: FibreKnot,
+    ) -> (FibreKnot, FibreKnot) {
+        // Candidates are tried nearest first; a hidden one moves the bound
+        // past it and the scan runs again.
+        let (mut bound_lo, mut bound_hi) = (theta, theta);
+        let (mut done_lo, mut done_hi) = (false, false);
+        while !(done_lo && done_hi) {
+            let (mut best_lo, mut best_hi): (Option<FibreKnot>, Option<FibreKnot>) = (None, None);
+            for e in &self.edges {
+                let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
+                if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
+                    continue;
+                }
+                let t = sa / (sa - sb);
+                let q = e.a + (e.b - e.a) * t;
+                let d = q - x;
+                let (dp, du) = (d.dot(p), d.dot(u));
+                if du <= 0.0 {
+                    continue; // the other half of the great circle
+                }
+                let th = du.atan2(dp);
+                let knot = FibreKnot {
+                    theta: th,
+                    edge: Some((q, e.b - e.a, e.shape)),
+                };
+                if !done_lo
+                    && th < bound_lo
+                    && th > lo.theta
+                    && best_lo.is_none_or(|b| th > b.theta)
+                {
+                    best_lo = Some(knot);
+                }
+                if !done_hi
+                    && th > bound_hi
+                    && th < hi.theta
+                    && best_hi.is_none_or(|b| th < b.theta)
+                {
+                    best_hi = Some(knot);
+                }
+            }
+            let settle = |done: &mut bool, best: Option<FibreKnot>, bound: &mut f64, k: &mut FibreKnot| {
+                if *done {
+                    return;
+                }
+                match best {
+                    None => *done = true,
+                    Some(b) => {
+                        let (q, _, _) = b.edge.unwrap_or((x, DVec3::ZERO, 0));
+                        if self.visible_point(x, q, skip) {
+                            *k = b;
+                            *done = true;
+                        } else {
+                            *bound = b.theta;
+                        }
+                    }
+                }
+            };
+            settle(&mut done_lo, best_lo, &mut bound_lo, &mut lo);
+            settle(&mut done_hi, best_hi, &mut bound_hi, &mut hi);
+        }
+        (lo, hi)
+    }
+
+    /// Whether the edge point `q` is seen from `x` (nothing opaque strictly
+    /// between; the edge's own faces end at `q`).
+    fn visible_point(&self, x: DVec3, q: DVec3, skip: u32) -> bool {
+        use crate::path::Geometry;
+        if skip == NO_PRIM {
+            self.visible(x, q, NO_PRIM)
+        } else {
+            self.visible(x, q, skip)
+        }
+    }
+
+    /// One slot's direction velocity and divergence under the warp.
+    pub(super) fn fibre_velocity(
+        &self,
+        warp: &SpaceWarp,
+        x: DVec3,
+        w: DVec3,
+        u: DVec3,
+        spin: DVec3,
+        velocity: impl Fn(DVec3, u32) -> DVec3,
+    ) -> (DVec3, f64) {
+        let rigid = spin.cross(w);
+        if warp.m == DVec3::ZERO {
+            return (rigid, 0.0);
+        }
+        // α at a knot: the crossing's slide along the fibre, relative to
+        // the frame (the vertex moves at u, the frame turns at Ω).
+        let rate = |k: &FibreKnot| -> f64 {
+            let Some((q, dir, shape)) = k.edge else {
+                return 0.0;
+            };
+            let r = q - x;
+            let v_rel = velocity(q, shape) - u - spin.cross(r);
+            let across = dir.dot(warp.m);
+            if across == 0.0 {
+                return 0.0;
+            }
+            // The crossing stays in the fixed plane: it slides along the
+            // edge by what takes it off the plane.
+            let slide = v_rel - dir * (v_rel.dot(warp.m) / across);
+            let (s, c) = k.theta.sin_cos();
+            let e_theta = warp.u * c - warp.p * s;
+            slide.dot(e_theta) / r.length()
+        };
+        let (a_lo, a_hi) = (rate(&warp.lo), rate(&warp.hi));
+        let span = warp.hi.theta - warp.lo.theta;
+        if span <= 0.0 {
+            return (rigid, 0.0);
+        }
+        let slope = (a_hi - a_lo) / span;
+        let alpha = a_lo + slope * (warp.theta - warp.lo.theta);
+        let (s, c) = warp.theta.sin_cos();
+        let e_theta = warp.u * c - warp.p * s;
+        (rigid + e_theta * alpha, slope + alpha * c / s)
+    }
+
+    /// The meshes whose motion the warp follows.
+    pub(super) fn fibre_shapes(&self, warp: &SpaceWarp, mut f: impl FnMut(u32)) {
+        for k in [warp.lo, warp.hi] {
+            if let Some((_, _, shape)) = k.edge {
+                f(shape);
+            }
+        }
+    }
+}
