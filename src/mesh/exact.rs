@@ -643,7 +643,10 @@ impl OccluderScene {
 
 /// The occluder scene with a closed box instead of the square: the same
 /// sensor and lamp, and an axis-aligned black cube of side `side` centred at
-/// `centre`.
+/// `centre`. A box face lying in a plane through the sensor (e.g. the face
+/// `y = 0` of a box spanning `0 ≤ y ≤ a`) is seen edge-on: `E` has a kink
+/// there (which face bounds the shadow switches), and the sensitivities are
+/// one-sided.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoxScene {
     /// Half the lamp's side.
