@@ -182,23 +182,24 @@ impl Space {
                     best_hi = Some(knot);
                 }
             }
-            let settle = |done: &mut bool, best: Option<FibreKnot>, bound: &mut f64, k: &mut FibreKnot| {
-                if *done {
-                    return;
-                }
-                match best {
-                    None => *done = true,
-                    Some(b) => {
-                        let (q, _, _) = b.edge.unwrap_or((x, DVec3::ZERO, 0));
-                        if self.visible_point(x, q, skip) {
-                            *k = b;
-                            *done = true;
-                        } else {
-                            *bound = b.theta;
+            let settle =
+                |done: &mut bool, best: Option<FibreKnot>, bound: &mut f64, k: &mut FibreKnot| {
+                    if *done {
+                        return;
+                    }
+                    match best {
+                        None => *done = true,
+                        Some(b) => {
+                            let (q, _, _) = b.edge.unwrap_or((x, DVec3::ZERO, 0));
+                            if self.visible_point(x, q, skip) {
+                                *k = b;
+                                *done = true;
+                            } else {
+                                *bound = b.theta;
+                            }
                         }
                     }
-                }
-            };
+                };
             settle(&mut done_lo, best_lo, &mut bound_lo, &mut lo);
             settle(&mut done_hi, best_hi, &mut bound_hi, &mut hi);
         }
