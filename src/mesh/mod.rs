@@ -7,7 +7,6 @@ pub mod scene;
 
 pub use scene::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
 pub mod boundaries;
-pub mod file;
 pub mod lobe;
 pub mod methods;
 pub mod space;
