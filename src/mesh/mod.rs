@@ -2,6 +2,10 @@
 //! and scale, on the path core that flatland uses ([`crate::path`]). The
 //! book's 3D chapter derives what differs from flatland: silhouette edges
 //! instead of corners.
+//!
+//! `scene` holds the validated scene, `file` its TOML/JSON file form (meshes
+//! inline or in OBJ files).
+pub mod file;
 pub mod scene;
 
 pub use scene::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
