@@ -126,9 +126,25 @@ fn bad_obj_files_are_named() {
     let path = scene_with("empty", OCC, &[("occ.obj", "# nothing\n")]);
     let e = err_of(file::load(&path));
     assert!(e.contains("\"occ\" has no triangles"), "{e}");
-    let path = scene_with("oob", OCC, &[("occ.obj", "v 0 0 1\nv 1 0 1\nf 1 2 7\n")]);
-    let e = err_of(file::load(&path));
-    assert!(e.contains("occ.obj"), "{e}");
+    // Odd OBJ text is refused, never a panic.
+    for (i, obj) in [
+        "v 0 0 1\nv 1 0 1\nf 1 2 7\n",
+        "v 0 0 1\nv 1 0 1\nv 0 1 1\nf 0 1 2\n",
+        "v 0 0 1\nf 1\n",
+        "v 0 0\nv 1 0\nv 0 1\nf 1 2 3\n",
+        "f\n",
+        "v 0 0 1\nv 1 0 1\nv 0 1 1\nf 1 2 -9\n",
+        "v nan 0 1\nv 1 0 1\nv 0 1 1\nf 1 2 3\n",
+        "\u{0}\u{1}binary",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let path = scene_with(&format!("odd{i}"), OCC, &[("occ.obj", obj)]);
+        let e = err_of(file::load(&path));
+        assert!(e.contains("scene.toml: "), "{obj:?}: {e}");
+        assert!(e.contains("\"occ\""), "{obj:?}: {e}");
+    }
 }
 
 #[test]
