@@ -94,7 +94,7 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
 pub const MAX_SCENE_BYTES: u64 = 256 << 20;
 
 /// The text of the file at `path`, at most [`MAX_SCENE_BYTES`] long.
-fn read_capped(path: &Path) -> Result<String, Error> {
+pub(crate) fn read_capped(path: &Path) -> Result<String, Error> {
     use std::io::Read;
     let cannot =
         |e: std::io::Error| Error::Scene(format!("cannot read scene file {}: {e}", path.display()));
@@ -144,7 +144,7 @@ pub fn to_toml(scene: &Scene) -> String {
 /// serde_json's message (which ends "at line L column C"), preceded by the
 /// key being read there when the message names no field (a wrong type, an
 /// unknown variant).
-fn json_error(text: &str, e: &serde_json::Error) -> Error {
+pub(crate) fn json_error(text: &str, e: &serde_json::Error) -> Error {
     let msg = e.to_string();
     let names_field = msg.contains("field `");
     let key = (e.classify() == serde_json::error::Category::Data && !names_field && e.line() > 0)

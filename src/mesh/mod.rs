@@ -1,16 +1,23 @@
 //! Three dimensions: triangle-mesh scenes whose meshes translate, rotate
 //! and scale, on the path core that flatland uses ([`crate::path`]). The
 //! book's 3D chapter derives what differs from flatland: silhouette edges
-//! instead of corners.
-pub mod exact;
-pub mod scene;
-
-pub use scene::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
+//! instead of corners, and a warp on the sphere.
+//!
+//! - [`scene`]: the validated scene; [`file`]: its TOML/JSON file form
+//!   (meshes inline or in OBJ files);
+//! - [`space`]: the scene behind the path core's `Geometry`; [`lobe`]: the
+//!   3D lobes; [`boundaries`]: the edges behind `Boundaries`; [`warp`]: the
+//!   expectation method's fibre warp;
+//! - [`methods`]: the estimators; [`exact`]: closed-form references.
 pub mod boundaries;
+pub mod exact;
+pub mod file;
 pub mod lobe;
 pub mod methods;
+pub mod scene;
 pub mod space;
 mod tris;
 pub mod warp;
 
+pub use scene::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
 pub use space::Space;

@@ -18,6 +18,8 @@ mod repr;
 mod tests;
 mod validate;
 
+pub use validate::{MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE};
+
 /// Largest extinction coefficient times scene size accepted: beyond it a
 /// medium is opaque for every purpose and the weights underflow.
 pub const MAX_OPTICAL_THICKNESS: f64 = 1e4;

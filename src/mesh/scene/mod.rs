@@ -6,12 +6,21 @@
 //! configuration.
 //!
 //! This file holds the data types and the validated [`Scene`] with its
-//! accessors; `validate` builds a scene step by step.
+//! accessors; `validate` builds a scene step by step, `geometry` holds the
+//! exact predicates it uses (triangle distances, winding numbers) and `repr`
+//! the file forms of the tagged enums.
 use crate::error::Error;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
+pub mod geometry;
+mod repr;
+#[cfg(test)]
+mod tests;
 mod validate;
+
+pub use crate::flat::scene::{MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE};
+pub use validate::{DEGENERATE_AREA, TOUCH_DISTANCE};
 
 /// What happens to light arriving at a mesh: the path core's surfaces, read
 /// and written in the same file form as flatland's.
@@ -61,8 +70,12 @@ impl Shape {
     }
 }
 
-/// How a parameter moves its mesh (with its medium).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// How a parameter moves its mesh (with its medium). File form:
+/// `{ kind = "translate_x" }` (`_y`, `_z`), `{ kind = "rotate", axis = [x, y,
+/// z], pivot = [x, y, z] }`, `{ kind = "scale", pivot = [x, y, z] }` (pivots
+/// optional).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(from = "repr::Motion", into = "repr::Motion")]
 pub enum Motion {
     /// Translation along x (π = offset, nominal 0).
     TranslateX,
@@ -127,7 +140,8 @@ impl Motion {
 }
 
 /// A shape parameter π whose sensitivity `∂I/∂π` is estimated.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Parameter {
     /// Unique name (the key of its sensitivity).
     pub name: String,
@@ -137,8 +151,11 @@ pub struct Parameter {
     pub motion: Motion,
 }
 
-/// What is measured, at a static point.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// What is measured, at a static point. File form: `{ kind =
+/// "irradiance", point = [x, y, z], normal = [x, y, z] }` or `{ kind =
+/// "radiance", point = [x, y, z], direction = [x, y, z] }`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(from = "repr::Sensor", into = "repr::Sensor")]
 pub enum Sensor {
     /// Radiance arriving at `point` from `direction` (the direction the
     /// sensor looks toward; unit after validation).

@@ -1,145 +1,136 @@
-//! Building a [`Scene`]: welding, checks, medium nesting.
-//! (A first version: welding by exact position and closedness; the full
-//! checks follow.)
-use super::{Motion, Parameter, Scene, Sensor, Shape};
-use crate::error::Error;
+//! Validating and building a [`Scene`]: [`Scene::new`] as a sequence of
+//! named steps, each checking one thing a user can get wrong (with a message
+//! naming the shape, its vertex or triangle, the parameter or the sensor at
+//! fault) or building one of the scene's tables. The steps run in a fixed
+//! order, so a scene with several faults always reports the first:
+//!
+//! 1. each shape as given: name, triangle indices, finite coordinates,
+//!    surface and medium numbers ([`check_shape`]);
+//! 2. welding by exact position, dropping unused vertices ([`weld`]);
+//! 3. the scene's size ([`MIN_SIZE`]..[`MAX_SIZE`]);
+//! 4. each mesh's triangles and edges: degenerate triangles, non-manifold
+//!    edges, orientation, closedness ([`topology`]);
+//! 5. meshes that cross or touch ([`check_crossings`]);
+//! 6. closed meshes turned outward ([`orient`]);
+//! 7. parameters, sensor, optical thickness, media nesting.
+//!
+//! Indices and coordinates are checked before welding (welding needs
+//! indices in range, and the messages then name the user's indices);
+//! welding keeps the triangles' order, so triangle indices in later
+//! messages are the user's too. Vertex indices in later messages are those
+//! of the welded mesh.
+use super::geometry::{point_triangle_distance, signed_volume, triangles_within, winding_number};
+use super::{
+    MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE, Medium, Motion, Parameter, Scene,
+    Sensor, Shape, Surface,
+};
+use crate::error::{Error, Num};
+use crate::flat::scene::MAX_SCATTERING_EVENTS;
 use glam::DVec3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
+
+/// A triangle whose area is at most `DEGENERATE_AREA × d²`, with `d` the
+/// diagonal of its mesh's bounding box, is degenerate (a sliver the tracer
+/// could not give a normal to). The same factor times `d³` is the least
+/// volume a closed mesh must enclose.
+pub const DEGENERATE_AREA: f64 = 1e-12;
+
+/// Two meshes closer than `TOUCH_DISTANCE × size` (the scene's size) touch:
+/// at such distances a ray tracer's offsets cannot tell them apart.
+pub const TOUCH_DISTANCE: f64 = 1e-12;
+
+/// A sensor closer than `SENSOR_DISTANCE × size` to a triangle lies on it
+/// (flatland's rule).
+const SENSOR_DISTANCE: f64 = 1e-9;
 
 fn config<T>(msg: String) -> Result<T, Error> {
     Err(Error::Scene(msg))
 }
 
-/// Merges vertices at the same position; returns the welded mesh.
-fn weld(shape: &mut Shape) {
-    let mut index: HashMap<[u64; 3], u32> = HashMap::new();
-    let mut vertices = Vec::new();
-    let map: Vec<u32> = shape
-        .vertices
-        .iter()
-        .map(|v| {
-            let key = [v.x, v.y, v.z].map(|c| (c + 0.0).to_bits());
-            *index.entry(key).or_insert_with(|| {
-                vertices.push(*v);
-                (vertices.len() - 1) as u32
-            })
-        })
-        .collect();
-    for t in &mut shape.triangles {
-        *t = t.map(|i| map[i as usize]);
-    }
-    shape.vertices = vertices;
+fn show(p: DVec3) -> String {
+    format!("[{}, {}, {}]", Num(p.x), Num(p.y), Num(p.z))
 }
 
-/// Whether every edge is shared by exactly two triangles, once in each
-/// direction.
-fn closed(shape: &Shape) -> bool {
-    let mut count: HashMap<(u32, u32), i32> = HashMap::new();
-    for t in &shape.triangles {
-        for i in 0..3 {
-            let (a, b) = (t[i], t[(i + 1) % 3]);
-            *count.entry((a, b)).or_default() += 1;
-        }
+fn finite(what: &str, p: DVec3) -> Result<(), Error> {
+    if p.is_finite() {
+        Ok(())
+    } else {
+        config(format!("{what} = {} is not finite", show(p)))
     }
-    count
-        .iter()
-        .all(|(&(a, b), &n)| n == 1 && count.get(&(b, a)) == Some(&1))
 }
 
-/// Whether `p` is inside the closed mesh `s` (parity of crossings along a
-/// fixed skew direction).
-pub(super) fn inside(s: &Shape, p: DVec3) -> bool {
-    let w = DVec3::new(0.5773, 0.5774, 0.5775).normalize();
-    let mut n = 0;
-    for i in 0..s.triangles.len() {
-        let t = s.triangle(i);
-        let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
-        let q = w.cross(e2);
-        let det = e1.dot(q);
-        if det == 0.0 {
-            continue;
-        }
-        let o = p - t[0];
-        let u = o.dot(q) / det;
-        let r = o.cross(e1);
-        let v = w.dot(r) / det;
-        let d = e2.dot(r) / det;
-        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && d > 0.0 {
-            n += 1;
-        }
+fn unit(what: &str, v: DVec3) -> Result<DVec3, Error> {
+    finite(what, v)?;
+    // Scaled first, so that no length overflows.
+    let m = v.abs().max_element();
+    let u = if m > 0.0 { v / m } else { v };
+    let n = u.length();
+    if n > 0.0 && n.is_finite() {
+        Ok(u / n)
+    } else {
+        config(format!("{what} = {} has no direction", show(v)))
     }
-    n % 2 == 1
 }
 
 impl Scene {
-    /// Validates and welds `shapes`, resolves `parameters`' pivots and axes.
+    /// Validates and builds a scene (steps in the module docs). Each mesh is
+    /// welded by exact position (`−0.0 == 0.0`), unused vertices dropped,
+    /// and a closed mesh whose signed volume is negative has every triangle
+    /// flipped, so that normals `(b−a)×(c−a)` point out. Pivots default to
+    /// the welded mesh's vertex centroid; axes, normals and directions are
+    /// normalised.
+    ///
+    /// Errors ([`Error::Scene`]) name the shape, vertex, triangle, parameter
+    /// or sensor at fault: no shapes, empty or repeated names, a mesh
+    /// without triangles, indices out of range, non-finite coordinates,
+    /// degenerate triangles ([`DEGENERATE_AREA`]), edges shared by more than
+    /// two triangles, a watertight mesh whose triangles are not consistently
+    /// oriented (refused, not repaired: a mesh's winding is the user's
+    /// statement of its faces), a closed mesh enclosing no volume, a medium
+    /// on an open or opaque mesh, a transparent mesh without a medium,
+    /// coefficients out of range (κs < 0, κe < κs, |g| ≥ 1, radiance < 0,
+    /// albedo ∉ `[0, 1]`), a medium too thick ([`MAX_OPTICAL_THICKNESS`]), a
+    /// size outside [`MIN_SIZE`]..[`MAX_SIZE`], two meshes that cross or
+    /// touch ([`TOUCH_DISTANCE`]), bad parameters (too many, empty or
+    /// repeated names, unknown shapes, zero or non-finite axes and pivots),
+    /// a non-finite sensor, a sensor on a surface or inside an opaque closed
+    /// mesh.
     pub fn new(
         mut shapes: Vec<Shape>,
-        mut parameters: Vec<Parameter>,
+        parameters: Vec<Parameter>,
         sensor: Sensor,
     ) -> Result<Scene, Error> {
+        if shapes.is_empty() {
+            return config("a scene needs at least one shape".into());
+        }
+        let mut names = HashSet::with_capacity(shapes.len());
+        for (k, s) in shapes.iter().enumerate() {
+            let repeated = !names.insert(s.name.as_str());
+            check_shape(k, s, repeated)?;
+        }
         for s in &mut shapes {
             weld(s);
         }
-        let closed: Vec<bool> = shapes.iter().map(closed).collect();
-        let mut parameter_shape = Vec::new();
-        for p in &mut parameters {
-            let Some(k) = shapes.iter().position(|s| s.name == p.shape) else {
-                return config(format!("parameter {:?}: no shape {:?}", p.name, p.shape));
-            };
-            parameter_shape.push(k as u32);
-            let c = shapes[k].centroid();
-            p.motion = match p.motion {
-                Motion::Rotate { axis, pivot } => Motion::Rotate {
-                    axis: axis.normalize(),
-                    pivot: Some(pivot.unwrap_or(c)),
-                },
-                Motion::Scale { pivot } => Motion::Scale {
-                    pivot: Some(pivot.unwrap_or(c)),
-                },
-                m => m,
-            };
-        }
-        let sensor = match sensor {
-            Sensor::Radiance { point, direction } => Sensor::Radiance {
-                point,
-                direction: direction.normalize(),
-            },
-            Sensor::Irradiance { point, normal } => Sensor::Irradiance {
-                point,
-                normal: normal.normalize(),
-            },
-        };
-        let (mut lo, mut hi) = (sensor.point(), sensor.point());
-        for s in &shapes {
-            for v in &s.vertices {
-                lo = lo.min(*v);
-                hi = hi.max(*v);
+        let size = scene_size(&shapes)?;
+        let closed = shapes
+            .iter()
+            .map(topology)
+            .collect::<Result<Vec<bool>, Error>>()?;
+        for (s, &c) in shapes.iter().zip(&closed) {
+            if s.medium.is_some() && !c {
+                return config(format!(
+                    "shape {:?} has a medium but is not closed (every edge must be shared \
+                     by exactly two triangles, in opposite directions)",
+                    s.name
+                ));
             }
         }
-        let size = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        // The innermost medium mesh around a point: the smallest (by box)
-        // closed medium mesh containing it.
-        let around = |p: DVec3, except: usize| -> Option<u32> {
-            let mut best: Option<(f64, u32)> = None;
-            for (k, s) in shapes.iter().enumerate() {
-                if k == except || s.medium.is_none() || !closed[k] || !inside(s, p) {
-                    continue;
-                }
-                let extent = s
-                    .vertices
-                    .iter()
-                    .fold(0.0f64, |m, v| m.max((*v - s.vertices[0]).length()));
-                if best.is_none_or(|b| extent < b.0) {
-                    best = Some((extent, k as u32));
-                }
-            }
-            best.map(|b| b.1)
-        };
-        let parent = (0..shapes.len())
-            .map(|k| around(shapes[k].vertices[0], k))
-            .collect();
-        let sensor_medium = around(sensor.point(), usize::MAX);
+        check_crossings(&shapes, size)?;
+        let volume = orient(&mut shapes, &closed)?;
+        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters)?;
+        let sensor = check_sensor(sensor, &shapes, &closed, size)?;
+        check_optical_thickness(&shapes, size)?;
+        let (parent, sensor_medium) = nest_media(&shapes, &closed, &volume, sensor.point());
         Ok(Scene {
             shapes,
             parameters,
@@ -151,4 +142,488 @@ impl Scene {
             size,
         })
     }
+}
+
+/// Checks shape `k` as given: its name (`repeated`: an earlier shape has
+/// it), its triangles' indices, its coordinates, its surface and medium.
+fn check_shape(k: usize, s: &Shape, repeated: bool) -> Result<(), Error> {
+    let name = &s.name;
+    if name.is_empty() {
+        return config(format!("shape {k} has an empty name"));
+    }
+    if repeated {
+        return config(format!("two shapes are named {name:?}"));
+    }
+    if s.triangles.is_empty() {
+        return config(format!("shape {name:?} has no triangles"));
+    }
+    let n = s.vertices.len();
+    for (i, t) in s.triangles.iter().enumerate() {
+        if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
+            return config(format!(
+                "shape {name:?}: triangle {i} uses vertex {v}, but the mesh has {n} vertices \
+                 (indices start at 0)"
+            ));
+        }
+    }
+    for (i, &v) in s.vertices.iter().enumerate() {
+        finite(&format!("shape {name:?} vertex {i}"), v)?;
+    }
+    check_surface(name, &s.surface)?;
+    match (&s.medium, s.surface) {
+        (Some(m), Surface::Transparent) => check_medium(name, m),
+        (Some(_), _) => config(format!(
+            "shape {name:?} has a medium behind an opaque surface: \
+             make its surface transparent"
+        )),
+        (None, Surface::Transparent) => config(format!(
+            "shape {name:?} is transparent but holds no medium: it would be invisible"
+        )),
+        (None, _) => Ok(()),
+    }
+}
+
+fn check_surface(name: &str, s: &Surface) -> Result<(), Error> {
+    match *s {
+        Surface::Emitter { radiance } if !(radiance >= 0.0 && radiance.is_finite()) => {
+            config(format!(
+                "shape {name:?}: radiance {} is not a finite number ≥ 0",
+                Num(radiance)
+            ))
+        }
+        Surface::Reflector { albedo } if !(0.0..=1.0).contains(&albedo) => config(format!(
+            "shape {name:?}: albedo {} is not in [0, 1]",
+            Num(albedo)
+        )),
+        _ => Ok(()),
+    }
+}
+
+fn check_medium(name: &str, m: &Medium) -> Result<(), Error> {
+    if !(m.ks >= 0.0 && m.ks.is_finite()) {
+        return config(format!(
+            "shape {name:?}: κs = {} is not finite and ≥ 0",
+            Num(m.ks)
+        ));
+    }
+    if !(m.ke >= m.ks && m.ke.is_finite()) {
+        return config(format!(
+            "shape {name:?}: κe = {} must be finite and ≥ κs = {}",
+            Num(m.ke),
+            Num(m.ks)
+        ));
+    }
+    if m.g.abs() >= 1.0 || m.g.is_nan() {
+        return config(format!(
+            "shape {name:?}: Henyey–Greenstein g = {} is not in (−1, 1)",
+            Num(m.g)
+        ));
+    }
+    Ok(())
+}
+
+/// Merges the vertices at the same position (`−0.0` and `0.0` alike),
+/// remaps the triangles and drops the vertices no triangle uses; vertices
+/// are numbered in order of first use. Indices must be in range.
+pub(super) fn weld(shape: &mut Shape) {
+    let mut index: HashMap<[u64; 3], u32> = HashMap::with_capacity(shape.vertices.len());
+    let mut vertices = Vec::with_capacity(shape.vertices.len());
+    let mut map = vec![u32::MAX; shape.vertices.len()];
+    for t in &mut shape.triangles {
+        for i in t.iter_mut() {
+            let old = *i as usize;
+            if map[old] == u32::MAX {
+                let v = shape.vertices[old];
+                let key = [v.x, v.y, v.z].map(|c| (c + 0.0).to_bits());
+                map[old] = *index.entry(key).or_insert_with(|| {
+                    vertices.push(v);
+                    (vertices.len() - 1) as u32
+                });
+            }
+            *i = map[old];
+        }
+    }
+    shape.vertices = vertices;
+}
+
+fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
+    vertices
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
+/// The largest extent of the vertices' bounding box, within
+/// [`MIN_SIZE`]..[`MAX_SIZE`].
+fn scene_size(shapes: &[Shape]) -> Result<f64, Error> {
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for s in shapes {
+        let (l, h) = bounds(&s.vertices);
+        (lo, hi) = (lo.min(l), hi.max(h));
+    }
+    let size = (hi - lo).max_element();
+    if !(MIN_SIZE..=MAX_SIZE).contains(&size) {
+        return config(format!(
+            "the scene's size (largest extent of its vertices' bounding box) is {size:e}: \
+             sizes from {MIN_SIZE:e} to {MAX_SIZE:e} are supported; rescale the scene \
+             (only κ × size and ratios of lengths matter)"
+        ));
+    }
+    Ok(size)
+}
+
+/// The triangles using one edge (at most two: a third is an error).
+#[derive(Clone, Copy)]
+struct EdgeUse {
+    count: u8,
+    /// Triangle and whether it runs from the lower vertex index to the
+    /// higher, for the first two users.
+    by: [(u32, bool); 2],
+}
+
+/// Checks a welded mesh's triangles and edges and tells whether it is
+/// closed: rejects degenerate triangles, edges shared by more than two
+/// triangles and, on a watertight mesh (every edge shared by two
+/// triangles), an edge both triangles run along in the same direction.
+fn topology(s: &Shape) -> Result<bool, Error> {
+    let name = &s.name;
+    let (lo, hi) = bounds(&s.vertices);
+    let diagonal2 = (hi - lo).length_squared();
+    for (i, t) in s.triangles.iter().enumerate() {
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            return config(format!(
+                "shape {name:?}: triangle {i} is degenerate: two of its corners are the same \
+                 point"
+            ));
+        }
+        let [a, b, c] = s.triangle(i);
+        if (b - a).cross(c - a).length() / 2.0 <= DEGENERATE_AREA * diagonal2 {
+            return config(format!(
+                "shape {name:?}: triangle {i} is degenerate: its area is at most \
+                 {DEGENERATE_AREA:e} × (its mesh's diagonal)²"
+            ));
+        }
+    }
+    let mut edges: HashMap<(u32, u32), EdgeUse> = HashMap::with_capacity(3 * s.triangles.len());
+    for (i, t) in s.triangles.iter().enumerate() {
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            let use_ = (i as u32, a < b);
+            let entry = edges.entry((a.min(b), a.max(b))).or_insert(EdgeUse {
+                count: 0,
+                by: [use_; 2],
+            });
+            if entry.count >= 2 {
+                return config(format!(
+                    "shape {name:?}: the edge between vertices {} and {} is shared by \
+                     triangles {}, {} and {}: a mesh must be a manifold (at most two \
+                     triangles per edge)",
+                    a.min(b),
+                    a.max(b),
+                    entry.by[0].0,
+                    entry.by[1].0,
+                    i
+                ));
+            }
+            entry.by[entry.count as usize] = use_;
+            entry.count += 1;
+        }
+    }
+    if edges.values().any(|e| e.count != 2) {
+        return Ok(false);
+    }
+    // Watertight: report the first edge (by triangle) both neighbours run
+    // along in the same direction.
+    let mut bad: Option<(u32, u32, (u32, u32))> = None;
+    for (&edge, e) in &edges {
+        if e.by[0].1 == e.by[1].1 {
+            let pair = (e.by[0].0.min(e.by[1].0), e.by[0].0.max(e.by[1].0));
+            if bad.is_none_or(|b| (pair, edge) < ((b.0, b.1), b.2)) {
+                bad = Some((pair.0, pair.1, edge));
+            }
+        }
+    }
+    if let Some((i, j, (a, b))) = bad {
+        return config(format!(
+            "shape {name:?}: triangles {i} and {j} both run from vertex {a} to vertex {b}: \
+             a closed mesh must be oriented consistently (each edge traversed once in \
+             each direction)"
+        ));
+    }
+    Ok(true)
+}
+
+/// An axis-aligned box, widened by a tolerance where compared.
+#[derive(Clone, Copy)]
+struct Aabb {
+    lo: DVec3,
+    hi: DVec3,
+}
+
+impl Aabb {
+    fn of(points: &[DVec3]) -> Aabb {
+        let (lo, hi) = bounds(points);
+        Aabb { lo, hi }
+    }
+    fn meets(&self, o: &Aabb, tol: f64) -> bool {
+        (self.lo - tol).cmple(o.hi).all() && (o.lo - tol).cmple(self.hi).all()
+    }
+}
+
+/// Rejects triangles of different meshes that cross or come within
+/// [`TOUCH_DISTANCE`] × `size`. Broad phase: a sweep over x on the meshes'
+/// boxes finds the pairs of meshes whose boxes meet; for each pair, the
+/// triangles inside the other mesh's box are swept over x against each
+/// other, and the pairs whose boxes meet get the exact test
+/// ([`triangles_within`]). A large mesh beside small ones thus costs one
+/// pass over its triangles per neighbour.
+fn check_crossings(shapes: &[Shape], size: f64) -> Result<(), Error> {
+    let tol = TOUCH_DISTANCE * size;
+    let boxes: Vec<Aabb> = shapes.iter().map(|s| Aabb::of(&s.vertices)).collect();
+    let mut order: Vec<usize> = (0..shapes.len()).collect();
+    order.sort_by(|&i, &j| boxes[i].lo.x.total_cmp(&boxes[j].lo.x));
+    for (n, &k) in order.iter().enumerate() {
+        for &l in &order[n + 1..] {
+            if boxes[l].lo.x > boxes[k].hi.x + tol {
+                break;
+            }
+            if boxes[k].meets(&boxes[l], tol) {
+                check_pair(shapes, k.min(l), k.max(l), &boxes, tol)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Rejects a triangle of shape `k` within `tol` of one of shape `l`.
+fn check_pair(shapes: &[Shape], k: usize, l: usize, boxes: &[Aabb], tol: f64) -> Result<(), Error> {
+    // Triangles of either mesh inside the other's box: (box, side, index).
+    let mut items: Vec<(Aabb, usize, u32)> = Vec::new();
+    for (side, (me, other)) in [(k, l), (l, k)].into_iter().enumerate() {
+        let s = &shapes[me];
+        for i in 0..s.triangles.len() {
+            let b = Aabb::of(&s.triangle(i));
+            if b.meets(&boxes[other], tol) {
+                items.push((b, side, i as u32));
+            }
+        }
+    }
+    items.sort_by(|a, b| a.0.lo.x.total_cmp(&b.0.lo.x));
+    let mut active: [Vec<(Aabb, u32)>; 2] = [Vec::new(), Vec::new()];
+    for &(b, side, i) in &items {
+        let other = 1 - side;
+        active[other].retain(|(o, _)| o.hi.x + tol >= b.lo.x);
+        for &(o, j) in &active[other] {
+            if !b.meets(&o, tol) {
+                continue;
+            }
+            let (ti, tj) = if side == 0 { (i, j) } else { (j, i) };
+            let (sk, sl) = (&shapes[k], &shapes[l]);
+            if triangles_within(sk.triangle(ti as usize), sl.triangle(tj as usize), tol) {
+                return config(format!(
+                    "shapes {:?} (triangle {ti}) and {:?} (triangle {tj}) touch or cross: \
+                     shapes must be disjoint",
+                    sk.name, sl.name
+                ));
+            }
+        }
+        active[side].push((b, i));
+    }
+    Ok(())
+}
+
+/// Turns each closed mesh outward (flips every triangle if its signed
+/// volume is negative) and returns each mesh's enclosed volume (0 for open
+/// meshes); rejects a closed mesh enclosing no volume.
+fn orient(shapes: &mut [Shape], closed: &[bool]) -> Result<Vec<f64>, Error> {
+    let mut volume = vec![0.0; shapes.len()];
+    for (k, s) in shapes.iter_mut().enumerate() {
+        if !closed[k] {
+            continue;
+        }
+        let (lo, hi) = bounds(&s.vertices);
+        let origin = (lo + hi) / 2.0;
+        let v = signed_volume((0..s.triangles.len()).map(|i| s.triangle(i)), origin);
+        if v.abs() <= DEGENERATE_AREA * (hi - lo).length().powi(3) {
+            return config(format!(
+                "shape {:?} is closed but encloses no volume",
+                s.name
+            ));
+        }
+        if v < 0.0 {
+            for t in &mut s.triangles {
+                t.swap(1, 2);
+            }
+        }
+        volume[k] = v.abs();
+    }
+    Ok(volume)
+}
+
+/// The parameters with their pivots resolved (a mesh's vertex centroid
+/// where none is given) and axes normalised, and the index of the shape
+/// each moves; rejects too many parameters, empty or duplicate names,
+/// unknown shapes, non-finite pivots, zero or non-finite axes.
+fn resolve_parameters(
+    shapes: &[Shape],
+    parameters: &[Parameter],
+) -> Result<(Vec<Parameter>, Vec<u32>), Error> {
+    if parameters.len() > MAX_PARAMETERS {
+        return config(format!(
+            "{} parameters: at most {MAX_PARAMETERS} are supported",
+            parameters.len()
+        ));
+    }
+    let mut parameter_shape = Vec::with_capacity(parameters.len());
+    let mut resolved = Vec::with_capacity(parameters.len());
+    let mut names = HashSet::with_capacity(parameters.len());
+    for (j, p) in parameters.iter().enumerate() {
+        if p.name.is_empty() {
+            return config(format!("parameter {j} has an empty name"));
+        }
+        if !names.insert(p.name.as_str()) {
+            return config(format!("two parameters are named {:?}", p.name));
+        }
+        let Some(k) = shapes.iter().position(|s| s.name == p.shape) else {
+            return config(format!(
+                "parameter {:?} moves shape {:?}, which does not exist",
+                p.name, p.shape
+            ));
+        };
+        let pivot = |pivot: Option<DVec3>| -> Result<Option<DVec3>, Error> {
+            let c = pivot.unwrap_or_else(|| shapes[k].centroid());
+            finite(&format!("parameter {:?} pivot", p.name), c)?;
+            Ok(Some(c))
+        };
+        let motion = match p.motion {
+            Motion::Rotate { axis, pivot: c } => Motion::Rotate {
+                axis: unit(&format!("parameter {:?} axis", p.name), axis)?,
+                pivot: pivot(c)?,
+            },
+            Motion::Scale { pivot: c } => Motion::Scale { pivot: pivot(c)? },
+            m => m,
+        };
+        parameter_shape.push(k as u32);
+        resolved.push(Parameter {
+            motion,
+            ..p.clone()
+        });
+    }
+    Ok((resolved, parameter_shape))
+}
+
+/// Whether `p` is inside the closed (outward-oriented) mesh `s`: its
+/// generalized winding number is nearer 1 than 0.
+pub(super) fn inside(s: &Shape, p: DVec3) -> bool {
+    let b = Aabb::of(&s.vertices);
+    b.meets(&Aabb { lo: p, hi: p }, 0.0)
+        && winding_number((0..s.triangles.len()).map(|i| s.triangle(i)), p).abs() > 0.5
+}
+
+/// The sensor with its direction or normal normalised; rejects a sensor
+/// that is not finite, lies on a triangle (closer than `SENSOR_DISTANCE` ×
+/// `size`) or inside an opaque closed mesh.
+fn check_sensor(
+    sensor: Sensor,
+    shapes: &[Shape],
+    closed: &[bool],
+    size: f64,
+) -> Result<Sensor, Error> {
+    let sensor = match sensor {
+        Sensor::Radiance { point, direction } => {
+            finite("sensor point", point)?;
+            Sensor::Radiance {
+                point,
+                direction: unit("sensor direction", direction)?,
+            }
+        }
+        Sensor::Irradiance { point, normal } => {
+            finite("sensor point", point)?;
+            Sensor::Irradiance {
+                point,
+                normal: unit("sensor normal", normal)?,
+            }
+        }
+    };
+    let p = sensor.point();
+    for s in shapes {
+        for i in 0..s.triangles.len() {
+            if point_triangle_distance(p, s.triangle(i)) <= SENSOR_DISTANCE * size {
+                return config(format!(
+                    "the sensor at {} lies on shape {:?} (triangle {i})",
+                    show(p),
+                    s.name
+                ));
+            }
+        }
+    }
+    for (k, s) in shapes.iter().enumerate() {
+        if closed[k] && s.surface.is_opaque() && inside(s, p) {
+            return config(format!(
+                "the sensor at {} is inside the opaque shape {:?}",
+                show(p),
+                s.name
+            ));
+        }
+    }
+    Ok(sensor)
+}
+
+/// Rejects a medium thicker than [`MAX_OPTICAL_THICKNESS`] across the
+/// scene, or one in which a path would scatter more than
+/// [`MAX_SCATTERING_EVENTS`] times (flatland's rules).
+fn check_optical_thickness(shapes: &[Shape], size: f64) -> Result<(), Error> {
+    for s in shapes {
+        let Some(m) = s.medium else { continue };
+        if m.ke * size > MAX_OPTICAL_THICKNESS {
+            return config(format!(
+                "shape {:?}: κe × scene size = {} exceeds {MAX_OPTICAL_THICKNESS}",
+                s.name,
+                Num(m.ke * size)
+            ));
+        }
+        let tau = m.ks * size;
+        let ka = m.ke - m.ks;
+        let events = if ka > 0.0 {
+            (tau * tau).min(m.ks / ka)
+        } else {
+            tau * tau
+        };
+        if events > MAX_SCATTERING_EVENTS {
+            return config(format!(
+                "shape {:?}: κs × scene size = {tau:.4e} with albedo {:.6}: a path would \
+                 scatter ~{events:.1e} times (at most {MAX_SCATTERING_EVENTS:e} are \
+                 supported); lower κs or raise the absorption",
+                s.name,
+                m.ks / m.ke
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The medium mesh around each mesh (tested at its first vertex: meshes do
+/// not cross, so one vertex tells) and around the sensor at `p`: among the
+/// closed medium meshes containing the point, the one of least volume.
+fn nest_media(
+    shapes: &[Shape],
+    closed: &[bool],
+    volume: &[f64],
+    p: DVec3,
+) -> (Vec<Option<u32>>, Option<u32>) {
+    let medium_at = |q: DVec3, except: Option<usize>| -> Option<u32> {
+        shapes
+            .iter()
+            .enumerate()
+            .filter(|&(k, s)| Some(k) != except && s.medium.is_some() && closed[k] && inside(s, q))
+            .min_by(|a, b| volume[a.0].total_cmp(&volume[b.0]))
+            .map(|(k, _)| k as u32)
+    };
+    let parent = shapes
+        .iter()
+        .enumerate()
+        .map(|(k, s)| medium_at(s.vertices[0], Some(k)))
+        .collect();
+    (parent, medium_at(p, None))
 }

@@ -1,0 +1,113 @@
+//! The file forms of [`Motion`](super::Motion) and [`Sensor`](super::Sensor):
+//! internally tagged (`kind = "rotate"`) with every variant a struct
+//! variant, as flatland's (`crate::flat::scene`'s `repr`): serde's
+//! `deny_unknown_fields` lets unknown fields through on the unit variants of
+//! an internally tagged enum (serde-rs/serde#2123), so `{ kind =
+//! "translate_x", pivot = [0, 0, 0] }` would load without a word. The
+//! surface's file form is flatland's, shared through the path core.
+//!
+//! The fields of tagged enums are read through [`field`]: serde buffers a
+//! tagged table before reading it, so the parser's own message ("invalid
+//! type: string, expected f64") would not say which field is wrong.
+use glam::DVec3;
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// Deserializes a field, naming it in the error.
+fn field<'de, D: Deserializer<'de>, T: Deserialize<'de>>(name: &str, d: D) -> Result<T, D::Error> {
+    T::deserialize(d).map_err(|e| D::Error::custom(format_args!("field `{name}`: {e}")))
+}
+
+macro_rules! fields {
+    ($($name:ident: $t:ty),*) => {$(
+        fn $name<'de, D: Deserializer<'de>>(d: D) -> Result<$t, D::Error> {
+            field(stringify!($name), d)
+        }
+    )*};
+}
+fields!(axis: DVec3, pivot: Option<DVec3>, point: DVec3, direction: DVec3, normal: DVec3);
+
+#[derive(Clone, Copy, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Motion {
+    TranslateX {},
+    TranslateY {},
+    TranslateZ {},
+    Rotate {
+        #[serde(deserialize_with = "axis")]
+        axis: DVec3,
+        #[serde(
+            default,
+            deserialize_with = "pivot",
+            skip_serializing_if = "Option::is_none"
+        )]
+        pivot: Option<DVec3>,
+    },
+    Scale {
+        #[serde(
+            default,
+            deserialize_with = "pivot",
+            skip_serializing_if = "Option::is_none"
+        )]
+        pivot: Option<DVec3>,
+    },
+}
+
+impl From<Motion> for super::Motion {
+    fn from(m: Motion) -> Self {
+        match m {
+            Motion::TranslateX {} => Self::TranslateX,
+            Motion::TranslateY {} => Self::TranslateY,
+            Motion::TranslateZ {} => Self::TranslateZ,
+            Motion::Rotate { axis, pivot } => Self::Rotate { axis, pivot },
+            Motion::Scale { pivot } => Self::Scale { pivot },
+        }
+    }
+}
+
+impl From<super::Motion> for Motion {
+    fn from(m: super::Motion) -> Self {
+        match m {
+            super::Motion::TranslateX => Self::TranslateX {},
+            super::Motion::TranslateY => Self::TranslateY {},
+            super::Motion::TranslateZ => Self::TranslateZ {},
+            super::Motion::Rotate { axis, pivot } => Self::Rotate { axis, pivot },
+            super::Motion::Scale { pivot } => Self::Scale { pivot },
+        }
+    }
+}
+
+#[derive(Clone, Copy, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Sensor {
+    Radiance {
+        #[serde(deserialize_with = "point")]
+        point: DVec3,
+        #[serde(deserialize_with = "direction")]
+        direction: DVec3,
+    },
+    Irradiance {
+        #[serde(deserialize_with = "point")]
+        point: DVec3,
+        #[serde(deserialize_with = "normal")]
+        normal: DVec3,
+    },
+}
+
+impl From<Sensor> for super::Sensor {
+    fn from(s: Sensor) -> Self {
+        match s {
+            Sensor::Radiance { point, direction } => Self::Radiance { point, direction },
+            Sensor::Irradiance { point, normal } => Self::Irradiance { point, normal },
+        }
+    }
+}
+
+impl From<super::Sensor> for Sensor {
+    fn from(s: super::Sensor) -> Self {
+        match s {
+            super::Sensor::Radiance { point, direction } => Self::Radiance { point, direction },
+            super::Sensor::Irradiance { point, normal } => Self::Irradiance { point, normal },
+        }
+    }
+}
