@@ -40,6 +40,7 @@ impl Space {
 }
 
 impl Boundaries for Space {
+    // ANCHOR: sample_boundary
     /// An edge drawn with probability proportional to its weight, a point
     /// uniformly along it; `inv_pdf` is per unit arc length on the sphere
     /// seen from `x`.
@@ -80,6 +81,7 @@ impl Boundaries for Space {
             inv_pdf: total / weight * len * jacobian,
         })
     }
+    // ANCHOR_END: sample_boundary
 
     // ANCHOR: sides
     /// The faces at the edge on either side of the sight line `ω` from `x`:

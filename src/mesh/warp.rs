@@ -80,6 +80,7 @@ fn pole(x: DVec3) -> DVec3 {
 }
 
 impl Space {
+    // ANCHOR: fibre_warp
     /// The warp at `v` around `w`.
     pub(super) fn fibre_warp(&self, v: &Vertex<Self>, w: DVec3) -> SpaceWarp {
         let x = v.x;
@@ -129,6 +130,7 @@ impl Space {
             hi,
         }
     }
+    // ANCHOR_END: fibre_warp
 
     /// The visible edge crossings of the fibre nearest to θ on either side,
     /// within the knots `lo` and `hi` already found.
@@ -217,6 +219,7 @@ impl Space {
         }
     }
 
+    // ANCHOR: fibre_velocity
     /// One slot's direction velocity and divergence under the warp.
     pub(super) fn fibre_velocity(
         &self,
@@ -261,6 +264,7 @@ impl Space {
         let e_theta = warp.u * c - warp.p * s;
         (rigid + e_theta * alpha, slope + alpha * c / s)
     }
+    // ANCHOR_END: fibre_velocity
 
     /// The meshes whose motion the warp follows.
     pub(super) fn fibre_shapes(&self, warp: &SpaceWarp, mut f: impl FnMut(u32)) {
