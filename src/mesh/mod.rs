@@ -5,18 +5,19 @@
 //!
 //! - [`scene`]: the validated scene; [`file`]: its TOML/JSON file form
 //!   (meshes inline or in OBJ files);
+//! - [`bvh`]: ray casting through obvhs, every hit re-tested in f64;
 //! - [`space`]: the scene behind the path core's `Geometry`; [`lobe`]: the
 //!   3D lobes; [`boundaries`]: the edges behind `Boundaries`; [`warp`]: the
 //!   expectation method's fibre warp;
 //! - [`methods`]: the estimators; [`exact`]: closed-form references.
 pub mod boundaries;
+pub mod bvh;
 pub mod exact;
 pub mod file;
 pub mod lobe;
 pub mod methods;
 pub mod scene;
 pub mod space;
-mod tris;
 pub mod warp;
 
 pub use scene::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};

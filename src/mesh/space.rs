@@ -6,7 +6,7 @@
 //! [`boundaries`](super::boundaries). Book: chapter "Three dimensions".
 use super::lobe::SpaceLobe;
 use super::scene::{Scene, Sensor as SceneSensor};
-use super::tris::TriangleBvh;
+use super::bvh::TriangleBvh;
 use crate::path::{Geometry, Hit, MediumId, NO_PRIM, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec3;
