@@ -41,28 +41,18 @@ impl Space {
 
 impl Boundaries for Space {
     // ANCHOR: sample_boundary
-    /// An edge drawn with probability proportional to its weight, a point
-    /// uniformly along it; `inv_pdf` is per unit arc length on the sphere
-    /// seen from `x`.
+    /// An edge drawn from the edge hierarchy (by weight among those that
+    /// can be discontinuities seen from `x`), a point uniformly along it;
+    /// `inv_pdf` is per unit arc length on the sphere seen from `x`.
     #[inline]
     fn sample_boundary(&self, x: DVec3, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
-        let cdf = if all { &self.all_cdf } else { &self.moving_cdf };
-        let total = *cdf.last()?;
-        if total <= 0.0 {
-            return None;
-        }
-        let s = (u * total).min(total * (1.0 - f64::EPSILON));
-        let pick = cdf.partition_point(|&c| c <= s).min(cdf.len() - 1);
-        let index = if all {
-            pick as u32
+        let tree = if all {
+            &self.all_edges
         } else {
-            self.moving_edges[pick]
+            &self.moving_edges
         };
-        let weight = self.edge_weight[index as usize];
-        let before = if pick == 0 { 0.0 } else { cdf[pick - 1] };
-        // The remainder of the uniform number within the edge's share is
-        // uniform again: the point along the edge.
-        let along = ((s - before) / weight).clamp(0.0, 1.0);
+        let (index, p, along) =
+            tree.sample(x, u, &self.edges, &self.edge_facts, &self.edge_weight)?;
         let edge = &self.edges[index as usize];
         let d = edge.b - edge.a;
         let q = edge.a + d * along;
@@ -78,7 +68,7 @@ impl Boundaries for Space {
             q,
             shape: edge.shape,
             index,
-            inv_pdf: total / weight * len * jacobian,
+            inv_pdf: len * jacobian / p,
         })
     }
     // ANCHOR_END: sample_boundary

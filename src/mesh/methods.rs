@@ -13,9 +13,9 @@
 //! - [`Method::Fd`]: central differences with common random numbers, one
 //!   pair of displaced scenes per parameter.
 //!
-//! [`Method::Expectation`] needs a continuous warp of the sphere of
-//! directions that follows every moving silhouette; it is not built for 3D
-//! yet and is refused with a clear error.
+//! - [`Method::Expectation`]: the same paths deformed by the fibre warp on
+//!   the sphere of directions ([`super::warp`]) and stretched free paths in
+//!   moving media; no boundary term, no nested path.
 use super::scene::{Motion, Scene};
 use super::space::Space;
 use crate::error::Error;

@@ -12,6 +12,7 @@
 //! - [`methods`]: the estimators; [`exact`]: closed-form references.
 pub mod boundaries;
 pub mod bvh;
+pub mod edges;
 pub mod exact;
 pub mod file;
 pub mod lobe;

@@ -4,9 +4,10 @@
 //! discontinuities (silhouette and crease edges,
 //! [`Boundaries`](crate::path::Boundaries)) are in
 //! [`boundaries`](super::boundaries). Book: chapter "Three dimensions".
+use super::bvh::TriangleBvh;
+use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
 use super::scene::{Scene, Sensor as SceneSensor};
-use super::bvh::TriangleBvh;
 use crate::path::{Geometry, Hit, MediumId, NO_PRIM, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec3;
@@ -54,11 +55,12 @@ pub struct Space {
     /// length times `θ/π` (θ the angle between its faces' normals; 1 for an
     /// open edge): the share of viewpoints from which it is a silhouette.
     pub(super) edge_weight: Vec<f64>,
-    /// Indices of the edges of moving meshes.
-    pub(super) moving_edges: Vec<u32>,
-    /// Cumulative weights over all edges, and over the moving ones.
-    pub(super) all_cdf: Vec<f64>,
-    pub(super) moving_cdf: Vec<f64>,
+    /// Per edge, its faces' normals and whether it is a discontinuity
+    /// from everywhere.
+    pub(super) edge_facts: Vec<EdgeFacts>,
+    /// The hierarchies over all edges and over those of moving meshes.
+    pub(super) all_edges: EdgeTree,
+    pub(super) moving_edges: EdgeTree,
 }
 
 impl Space {
@@ -145,19 +147,32 @@ impl Space {
             .collect();
         let params = scene.parameters().len();
         let moving = |k: u32| (0..params).any(|j| scene.parameter_shape(j) == k);
-        let moving_edges: Vec<u32> = (0..edges.len() as u32)
+        let edge_facts: Vec<EdgeFacts> = edges
+            .iter()
+            .map(|e| {
+                let n0 = normals[e.faces[0] as usize];
+                let open = e.faces[1] == NO_PRIM;
+                let n1 = if open {
+                    n0
+                } else {
+                    normals[e.faces[1] as usize]
+                };
+                let reflector = matches!(
+                    scene.shapes()[e.shape as usize].surface,
+                    Surface::Reflector { .. }
+                );
+                EdgeFacts {
+                    normals: [n0, n1],
+                    always: open || reflector,
+                }
+            })
+            .collect();
+        let all_ids: Vec<u32> = (0..edges.len() as u32).collect();
+        let moving_ids: Vec<u32> = (0..edges.len() as u32)
             .filter(|&i| moving(edges[i as usize].shape))
             .collect();
-        let cdf = |ids: &mut dyn Iterator<Item = usize>| {
-            let mut total = 0.0;
-            ids.map(|i| {
-                total += edge_weight[i];
-                total
-            })
-            .collect::<Vec<f64>>()
-        };
-        let all_cdf = cdf(&mut (0..edges.len()));
-        let moving_cdf = cdf(&mut moving_edges.iter().map(|&i| i as usize));
+        let all_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, all_ids);
+        let moving_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, moving_ids);
         Space {
             caster: TriangleBvh::new(tris.clone()),
             opaque: TriangleBvh::new(opaque_tris),
@@ -170,9 +185,9 @@ impl Space {
             emitter_area,
             edges,
             edge_weight,
+            edge_facts,
+            all_edges,
             moving_edges,
-            all_cdf,
-            moving_cdf,
         }
     }
 

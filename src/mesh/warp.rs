@@ -152,38 +152,40 @@ impl Space {
         let (mut done_lo, mut done_hi) = (false, false);
         while !(done_lo && done_hi) {
             let (mut best_lo, mut best_hi): (Option<FibreKnot>, Option<FibreKnot>) = (None, None);
-            for e in &self.edges {
-                let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
-                if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
-                    continue;
-                }
-                let t = sa / (sa - sb);
-                let q = e.a + (e.b - e.a) * t;
-                let d = q - x;
-                let (dp, du) = (d.dot(p), d.dot(u));
-                if du <= 0.0 {
-                    continue; // the other half of the great circle
-                }
-                let th = du.atan2(dp);
-                let knot = FibreKnot {
-                    theta: th,
-                    edge: Some((q, e.b - e.a, e.shape)),
-                };
-                if !done_lo
-                    && th < bound_lo
-                    && th > lo.theta
-                    && best_lo.is_none_or(|b| th > b.theta)
-                {
-                    best_lo = Some(knot);
-                }
-                if !done_hi
-                    && th > bound_hi
-                    && th < hi.theta
-                    && best_hi.is_none_or(|b| th < b.theta)
-                {
-                    best_hi = Some(knot);
-                }
-            }
+            self.all_edges
+                .crossings(x, m, u, &self.edges, &self.edge_facts, |i| {
+                    let e = &self.edges[i as usize];
+                    let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
+                    if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
+                        return;
+                    }
+                    let t = sa / (sa - sb);
+                    let q = e.a + (e.b - e.a) * t;
+                    let d = q - x;
+                    let (dp, du) = (d.dot(p), d.dot(u));
+                    if du <= 0.0 {
+                        return; // the other half of the great circle
+                    }
+                    let th = du.atan2(dp);
+                    let knot = FibreKnot {
+                        theta: th,
+                        edge: Some((q, e.b - e.a, e.shape)),
+                    };
+                    if !done_lo
+                        && th < bound_lo
+                        && th > lo.theta
+                        && best_lo.is_none_or(|b| th > b.theta)
+                    {
+                        best_lo = Some(knot);
+                    }
+                    if !done_hi
+                        && th > bound_hi
+                        && th < hi.theta
+                        && best_hi.is_none_or(|b| th < b.theta)
+                    {
+                        best_hi = Some(knot);
+                    }
+                });
             let settle =
                 |done: &mut bool, best: Option<FibreKnot>, bound: &mut f64, k: &mut FibreKnot| {
                     if *done {

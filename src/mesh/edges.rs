@@ -1,0 +1,323 @@
+//! A hierarchy over the edges of opaque meshes that answers, from a point
+//! `x`, which edges can be discontinuities of the integrand over directions
+//! there: silhouettes (the edge's two faces face `x` differently), open
+//! edges, and creases of reflectors. Each node bounds its edges' positions
+//! (a box) and their faces' normals (a cone); when every face in the node
+//! faces `x` the same way, the node holds no silhouette and is culled
+//! (Sander et al. 2000's silhouette cones; redner's edge tree uses the same
+//! idea in Hough space).
+//!
+//! Two queries, both `O(log n)`-ish on a mesh whose silhouette from `x` is a
+//! thin band:
+//!
+//! - [`EdgeTree::sample`]: an edge drawn by descending the tree, each child
+//!   chosen in proportion to its edges' total weight unless it is culled;
+//!   the probability of the edge drawn is the product of the choices, exact,
+//!   so the boundary terms stay unbiased (a dead end, both children culled,
+//!   draws nothing: only edges that cannot be discontinuities lose their
+//!   share);
+//! - [`EdgeTree::crossings`]: the discontinuity edges that cross a plane
+//!   through `x` on one side of a line, for the fibre warp's knots.
+//!
+//! Book: chapter "Three dimensions", section "Silhouette edges".
+use super::space::Edge;
+use crate::path::NO_PRIM;
+use glam::DVec3;
+use std::f64::consts::FRAC_PI_2;
+
+/// Most edges in a leaf.
+const LEAF: usize = 4;
+
+/// A node: the box and normal cone of its edges, their total weight, and
+/// its children (`count == 0`) or its edges (`order[first..first+count]`).
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    lo: DVec3,
+    hi: DVec3,
+    /// Unit axis of the cone of face normals.
+    axis: DVec3,
+    /// Its half-angle (π: no bound).
+    half_angle: f64,
+    /// Some edge inside is a discontinuity from everywhere (open edge, or
+    /// crease of a reflector).
+    always: bool,
+    weight: f64,
+    /// Left child (right = left + 1) or first edge.
+    first: u32,
+    count: u32,
+}
+
+/// Per edge, what the tree needs: its faces' normals and whether it is
+/// always a discontinuity.
+#[derive(Debug, Clone, Copy)]
+pub struct EdgeFacts {
+    /// The faces' unit normals (the second equals the first on an open
+    /// edge).
+    pub normals: [DVec3; 2],
+    /// Open edge, or crease of a reflector.
+    pub always: bool,
+}
+
+/// The hierarchy over a subset of a scene's edges.
+#[derive(Debug, Clone, Default)]
+pub struct EdgeTree {
+    nodes: Vec<Node>,
+    /// Edge indices in leaf order.
+    order: Vec<u32>,
+}
+
+/// Whether edge `e` (with `facts`) can be a discontinuity seen from `x`.
+#[inline]
+pub fn is_discontinuity(e: &Edge, facts: &EdgeFacts, x: DVec3) -> bool {
+    if facts.always || e.faces[1] == NO_PRIM {
+        return true;
+    }
+    let r = x - e.a;
+    let (s0, s1) = (facts.normals[0].dot(r), facts.normals[1].dot(r));
+    // Grazing (a face's plane through x) counts: conservative.
+    !((s0 > 0.0 && s1 > 0.0) || (s0 < 0.0 && s1 < 0.0))
+}
+
+impl EdgeTree {
+    /// The tree over the edges `ids` of `edges`.
+    pub fn new(edges: &[Edge], facts: &[EdgeFacts], weights: &[f64], ids: Vec<u32>) -> EdgeTree {
+        let mut tree = EdgeTree {
+            nodes: Vec::new(),
+            order: ids,
+        };
+        if tree.order.is_empty() {
+            return tree;
+        }
+        tree.nodes.push(Node {
+            lo: DVec3::ZERO,
+            hi: DVec3::ZERO,
+            axis: DVec3::Z,
+            half_angle: 0.0,
+            always: false,
+            weight: 0.0,
+            first: 0,
+            count: 0,
+        });
+        let n = tree.order.len();
+        tree.build(0, 0, n, edges, facts, weights);
+        tree
+    }
+
+    fn build(
+        &mut self,
+        node: usize,
+        start: usize,
+        end: usize,
+        edges: &[Edge],
+        facts: &[EdgeFacts],
+        weights: &[f64],
+    ) {
+        let ids = &mut self.order[start..end];
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        let mut sum = DVec3::ZERO;
+        let mut always = false;
+        let mut weight = 0.0;
+        for &i in ids.iter() {
+            let e = &edges[i as usize];
+            lo = lo.min(e.a).min(e.b);
+            hi = hi.max(e.a).max(e.b);
+            let f = &facts[i as usize];
+            sum += f.normals[0] + f.normals[1];
+            always |= f.always || e.faces[1] == NO_PRIM;
+            weight += weights[i as usize];
+        }
+        let axis = sum.normalize_or_zero();
+        let half_angle = if axis == DVec3::ZERO {
+            std::f64::consts::PI
+        } else {
+            ids.iter()
+                .flat_map(|&i| facts[i as usize].normals)
+                .map(|n| n.dot(axis).clamp(-1.0, 1.0).acos())
+                .fold(0.0, f64::max)
+        };
+        let mut this = Node {
+            lo,
+            hi,
+            axis,
+            half_angle,
+            always,
+            weight,
+            first: start as u32,
+            count: (end - start) as u32,
+        };
+        if end - start > LEAF {
+            // Median split on the longest axis of the midpoints' box.
+            let k = (hi - lo).max_position();
+            let mid = |i: &u32| {
+                let e = &edges[*i as usize];
+                (e.a + e.b)[k]
+            };
+            let half = (end - start) / 2;
+            ids.select_nth_unstable_by(half, |a, b| mid(a).total_cmp(&mid(b)));
+            let left = self.nodes.len();
+            this.first = left as u32;
+            this.count = 0;
+            self.nodes[node] = this;
+            let blank = self.nodes[node];
+            self.nodes.push(blank);
+            self.nodes.push(blank);
+            self.build(left, start, start + half, edges, facts, weights);
+            self.build(left + 1, start + half, end, edges, facts, weights);
+        } else {
+            self.nodes[node] = this;
+        }
+    }
+
+    /// Whether node `i` may hold a discontinuity seen from `x` (false when
+    /// every face in it faces `x` the same way).
+    #[inline]
+    fn open(&self, i: usize, x: DVec3) -> bool {
+        let n = &self.nodes[i];
+        if n.always || n.half_angle >= FRAC_PI_2 {
+            return true;
+        }
+        let c = 0.5 * (n.lo + n.hi);
+        let radius = 0.5 * (n.hi - n.lo).length();
+        let r = x - c;
+        let d = r.length();
+        if d <= radius {
+            return true;
+        }
+        let spread = (radius / d).asin() + n.half_angle;
+        let phi = (r / d).dot(n.axis).clamp(-1.0, 1.0).acos();
+        // All front-facing, or all back-facing, with a margin for rounding.
+        !(phi + spread < FRAC_PI_2 - 1e-9 || phi - spread > FRAC_PI_2 + 1e-9)
+    }
+
+    /// An edge drawn from `x` with `u ∈ [0, 1)`: its index, the probability
+    /// it was drawn with, and the uniform number left over (for the point on
+    /// it). `None` if the tree is culled away.
+    #[inline]
+    pub fn sample(
+        &self,
+        x: DVec3,
+        mut u: f64,
+        edges: &[Edge],
+        facts: &[EdgeFacts],
+        weights: &[f64],
+    ) -> Option<(u32, f64, f64)> {
+        if self.nodes.is_empty() || !self.open(0, x) {
+            return None;
+        }
+        let mut i = 0;
+        let mut p = 1.0;
+        loop {
+            let n = self.nodes[i];
+            if n.count > 0 {
+                let ids = &self.order[n.first as usize..(n.first + n.count) as usize];
+                let live = |e: u32| is_discontinuity(&edges[e as usize], &facts[e as usize], x);
+                let total: f64 = ids
+                    .iter()
+                    .filter(|&&e| live(e))
+                    .map(|&e| weights[e as usize])
+                    .sum();
+                if total <= 0.0 {
+                    return None;
+                }
+                let s = (u * total).min(total * (1.0 - f64::EPSILON));
+                let mut acc = 0.0;
+                for &e in ids.iter().filter(|&&e| live(e)) {
+                    let w = weights[e as usize];
+                    if s < acc + w || acc + w >= total {
+                        let rest = ((s - acc) / w).clamp(0.0, 1.0 - f64::EPSILON);
+                        return Some((e, p * w / total, rest));
+                    }
+                    acc += w;
+                }
+                return None;
+            }
+            let (l, r) = (n.first as usize, n.first as usize + 1);
+            let wl = if self.open(l, x) {
+                self.nodes[l].weight
+            } else {
+                0.0
+            };
+            let wr = if self.open(r, x) {
+                self.nodes[r].weight
+            } else {
+                0.0
+            };
+            let total = wl + wr;
+            if total <= 0.0 {
+                return None;
+            }
+            let pl = wl / total;
+            if u < pl {
+                u /= pl;
+                p *= pl;
+                i = l;
+            } else {
+                u = ((u - pl) / (1.0 - pl)).min(1.0 - f64::EPSILON);
+                p *= 1.0 - pl;
+                i = r;
+            }
+        }
+    }
+
+    /// Calls `f` with every discontinuity edge seen from `x` that may cross
+    /// the plane through `x` with unit normal `m` where `(q − x)·side > 0`.
+    #[inline]
+    pub fn crossings(
+        &self,
+        x: DVec3,
+        m: DVec3,
+        side: DVec3,
+        edges: &[Edge],
+        facts: &[EdgeFacts],
+        mut f: impl FnMut(u32),
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = [0u32; 128];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let i = stack[top] as usize;
+            let n = &self.nodes[i];
+            let c = 0.5 * (n.lo + n.hi);
+            let h = 0.5 * (n.hi - n.lo);
+            let reach = |v: DVec3| (c - x).dot(v).abs() <= h.dot(v.abs()) * (1.0 + 1e-12) + 1e-300;
+            let ahead = (c - x).dot(side) + h.dot(side.abs()) >= 0.0;
+            if !reach(m) || !ahead || !self.open(i, x) {
+                continue;
+            }
+            if n.count > 0 {
+                for &e in &self.order[n.first as usize..(n.first + n.count) as usize] {
+                    if is_discontinuity(&edges[e as usize], &facts[e as usize], x) {
+                        f(e);
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = n.first;
+                stack[top + 1] = n.first + 1;
+                top += 2;
+            } else {
+                // Deeper than the stack (not seen: median splits give depth
+                // log2(n/4)): visit the subtree's edges directly.
+                self.leaves_under(i, &mut |e| {
+                    if is_discontinuity(&edges[e as usize], &facts[e as usize], x) {
+                        f(e);
+                    }
+                });
+            }
+        }
+    }
+
+    fn leaves_under(&self, i: usize, f: &mut impl FnMut(u32)) {
+        let n = self.nodes[i];
+        if n.count > 0 {
+            for &e in &self.order[n.first as usize..(n.first + n.count) as usize] {
+                f(e);
+            }
+        } else {
+            self.leaves_under(n.first as usize, f);
+            self.leaves_under(n.first as usize + 1, f);
+        }
+    }
+}
