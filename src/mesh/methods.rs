@@ -11,8 +11,7 @@
 //!   on the moving boundaries; it also returns `∂I/∂x`, `∂I/∂y`, `∂I/∂z` at
 //!   the sensor;
 //! - [`Method::Fd`]: central differences with common random numbers, one
-//!   pair of displaced scenes per parameter.
-//!
+//!   pair of displaced scenes per parameter;
 //! - [`Method::Expectation`]: the same paths deformed by the fibre warp on
 //!   the sphere of directions ([`super::warp`]) and stretched free paths in
 //!   moving media; no boundary term, no nested path.
