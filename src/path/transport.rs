@@ -15,7 +15,7 @@
 //!
 //! The sensor-position slots (`∂I/∂x`, …) follow rendering's rules.
 //! Book: chapter "Flatland: one deformation, three estimators", section
-//! "Transport".
+//! "Transport"; in 3D, chapter "Three dimensions", section "Transport in 3D".
 use super::deform::{Deform, Scratch, Slots};
 use super::rendering::{Rendering, attached_connect, attached_scatter, leibniz};
 use super::walk::{Hooks, Leg, Vertex, radiance, walk};
