@@ -36,8 +36,11 @@ struct Node {
     hi: DVec3,
     /// Unit axis of the cone of face normals.
     axis: DVec3,
-    /// Its half-angle (π: no bound).
-    half_angle: f64,
+    /// Cosine and sine of its half-angle (≥ π/2: no bound).
+    cos_half: f64,
+    sin_half: f64,
+    /// The half-angle is π/2 or more.
+    unbounded: bool,
     /// Some edge inside is a discontinuity from everywhere (open edge, or
     /// crease of a reflector).
     always: bool,
@@ -92,7 +95,9 @@ impl EdgeTree {
             lo: DVec3::ZERO,
             hi: DVec3::ZERO,
             axis: DVec3::Z,
-            half_angle: 0.0,
+            cos_half: 1.0,
+            sin_half: 0.0,
+            unbounded: false,
             always: false,
             weight: 0.0,
             first: 0,
@@ -139,7 +144,9 @@ impl EdgeTree {
             lo,
             hi,
             axis,
-            half_angle,
+            cos_half: half_angle.cos(),
+            sin_half: half_angle.sin(),
+            unbounded: half_angle >= FRAC_PI_2,
             always,
             weight,
             first: start as u32,
@@ -173,7 +180,7 @@ impl EdgeTree {
     #[inline]
     fn open(&self, i: usize, x: DVec3) -> bool {
         let n = &self.nodes[i];
-        if n.always || n.half_angle >= FRAC_PI_2 {
+        if n.always || n.unbounded {
             return true;
         }
         let c = 0.5 * (n.lo + n.hi);
@@ -183,10 +190,22 @@ impl EdgeTree {
         if d <= radius {
             return true;
         }
-        let spread = (radius / d).asin() + n.half_angle;
-        let phi = (r / d).dot(n.axis).clamp(-1.0, 1.0).acos();
-        // All front-facing, or all back-facing, with a margin for rounding.
-        !(phi + spread < FRAC_PI_2 - 1e-9 || phi - spread > FRAC_PI_2 + 1e-9)
+        // The spread s = asin(R/d) + half-angle; the angle φ between the
+        // cone's axis and the direction to x. Every face faces x the same
+        // way if φ + s < π/2 or φ − s > π/2, i.e. cos(φ + s) > 0 or
+        // cos(φ − s) < 0 (s < π/2 keeps both in the range where that holds).
+        let (sin_b, cos_b) = (radius / d, (1.0 - (radius / d).powi(2)).max(0.0).sqrt());
+        let cos_s = cos_b * n.cos_half - sin_b * n.sin_half;
+        if cos_s <= 0.0 {
+            return true;
+        }
+        let sin_s = sin_b * n.cos_half + cos_b * n.sin_half;
+        let cos_phi = (r / d).dot(n.axis).clamp(-1.0, 1.0);
+        let sin_phi = (1.0 - cos_phi * cos_phi).max(0.0).sqrt();
+        let margin = 1e-9;
+        let front = cos_phi * cos_s - sin_phi * sin_s > margin;
+        let back = cos_phi * cos_s + sin_phi * sin_s < -margin;
+        !(front || back)
     }
 
     /// An edge drawn from `x` with `u ∈ [0, 1)`: its index, the probability

@@ -32,27 +32,43 @@ use crate::path::walk::Vertex;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-/// A knot of a fibre: its polar angle and, for an edge crossing, the
-/// crossing point, the edge's direction and the mesh.
+/// A knot of a fibre: its polar angle (and cosine) and, for an edge
+/// crossing, the crossing.
 #[derive(Debug, Clone, Copy)]
 pub struct FibreKnot {
     /// Polar angle from the pole.
     pub theta: f64,
+    /// Its cosine (the search compares cosines: no trigonometry).
+    cos: f64,
     /// The edge crossing, or `None` for a knot moving with the frame.
-    pub edge: Option<(DVec3, DVec3, u32)>,
+    pub edge: Option<Crossing>,
+}
+
+/// Where a fibre's plane crosses an edge, with what every slot's rate
+/// there needs.
+#[derive(Debug, Clone, Copy)]
+pub struct Crossing {
+    /// The crossing point.
+    pub q: DVec3,
+    /// The edge's direction `b − a`.
+    pub dir: DVec3,
+    /// The mesh.
+    pub shape: u32,
+    /// `e_θ` at the crossing's direction, `1/r`, `1/(dir·m)`.
+    e_theta: DVec3,
+    inv_r: f64,
+    inv_across: f64,
 }
 
 /// The warp at a vertex around a sampled direction.
 #[derive(Debug, Clone, Copy)]
 pub struct SpaceWarp {
-    /// The pole.
-    p: DVec3,
-    /// Unit vector with `ω = cos θ p + sin θ u` (the fibre's plane).
-    u: DVec3,
-    /// The plane's unit normal `p × u`.
+    /// The fibre's plane's unit normal `p × u`.
     m: DVec3,
-    /// ω's polar angle.
+    /// ω's polar angle, `e_θ` there and `cot θ`.
     theta: f64,
+    e_w: DVec3,
+    cot: f64,
     /// Nearest knots below and above θ.
     lo: FibreKnot,
     hi: FibreKnot,
@@ -90,16 +106,17 @@ impl Space {
         let s = perp.length();
         let still = |t: f64| FibreKnot {
             theta: t,
+            cos: t.cos(),
             edge: None,
         };
         if s < 1e-12 {
             // ω at a pole: the field is the frame's there.
             let theta = c.acos();
             return SpaceWarp {
-                p,
-                u: p.any_orthonormal_vector(),
                 m: DVec3::ZERO,
                 theta,
+                e_w: DVec3::ZERO,
+                cot: 0.0,
                 lo: still(theta),
                 hi: still(theta),
             };
@@ -120,14 +137,33 @@ impl Space {
                 hi = still(th);
             }
         }
-        let (lo, hi) = self.nearest_crossings(x, v.skip, p, u, m, theta, lo, hi);
+        let (lo, hi) = self.nearest_crossings(x, v.skip, p, u, m, c, lo, hi);
+        // The chosen crossings' angles and what the slots' rates need.
+        let finish = |k: FibreKnot| -> FibreKnot {
+            let Some(e) = k.edge else { return k };
+            let d = e.q - x;
+            let (dp, du) = (d.dot(p), d.dot(u));
+            let theta = du.atan2(dp);
+            let (st, ct) = theta.sin_cos();
+            let across = e.dir.dot(m);
+            FibreKnot {
+                theta,
+                cos: k.cos,
+                edge: Some(Crossing {
+                    e_theta: u * ct - p * st,
+                    inv_r: 1.0 / d.length(),
+                    inv_across: if across == 0.0 { 0.0 } else { 1.0 / across },
+                    ..e
+                }),
+            }
+        };
         SpaceWarp {
-            p,
-            u,
             m,
             theta,
-            lo,
-            hi,
+            e_w: u * c - p * s,
+            cot: c / s,
+            lo: finish(lo),
+            hi: finish(hi),
         }
     }
     // ANCHOR_END: fibre_warp
@@ -142,13 +178,14 @@ impl Space {
         p: DVec3,
         u: DVec3,
         m: DVec3,
-        theta: f64,
+        cos_theta: f64,
         mut lo: FibreKnot,
         mut hi: FibreKnot,
     ) -> (FibreKnot, FibreKnot) {
         // Candidates are tried nearest first; a hidden one moves the bound
-        // past it and the scan runs again.
-        let (mut bound_lo, mut bound_hi) = (theta, theta);
+        // past it and the scan runs again. Angles are compared by their
+        // cosines (θ ∈ [0, π] grows as cos θ falls).
+        let (mut bound_lo, mut bound_hi) = (cos_theta, cos_theta);
         let (mut done_lo, mut done_hi) = (false, false);
         while !(done_lo && done_hi) {
             let (mut best_lo, mut best_hi): (Option<FibreKnot>, Option<FibreKnot>) = (None, None);
@@ -166,22 +203,30 @@ impl Space {
                     if du <= 0.0 {
                         return; // the other half of the great circle
                     }
-                    let th = du.atan2(dp);
+                    let cos = dp / d.length();
                     let knot = FibreKnot {
-                        theta: th,
-                        edge: Some((q, e.b - e.a, e.shape)),
+                        theta: f64::NAN,
+                        cos,
+                        edge: Some(Crossing {
+                            q,
+                            dir: e.b - e.a,
+                            shape: e.shape,
+                            e_theta: DVec3::ZERO,
+                            inv_r: 0.0,
+                            inv_across: 0.0,
+                        }),
                     };
                     if !done_lo
-                        && th < bound_lo
-                        && th > lo.theta
-                        && best_lo.is_none_or(|b| th > b.theta)
+                        && cos > bound_lo
+                        && cos < lo.cos
+                        && best_lo.is_none_or(|b| cos < b.cos)
                     {
                         best_lo = Some(knot);
                     }
                     if !done_hi
-                        && th > bound_hi
-                        && th < hi.theta
-                        && best_hi.is_none_or(|b| th < b.theta)
+                        && cos < bound_hi
+                        && cos > hi.cos
+                        && best_hi.is_none_or(|b| cos > b.cos)
                     {
                         best_hi = Some(knot);
                     }
@@ -194,12 +239,12 @@ impl Space {
                     match best {
                         None => *done = true,
                         Some(b) => {
-                            let (q, _, _) = b.edge.unwrap_or((x, DVec3::ZERO, 0));
+                            let q = b.edge.map_or(x, |e| e.q);
                             if self.visible_point(x, q, skip) {
                                 *k = b;
                                 *done = true;
                             } else {
-                                *bound = b.theta;
+                                *bound = b.cos;
                             }
                         }
                     }
@@ -239,21 +284,14 @@ impl Space {
         // α at a knot: the crossing's slide along the fibre, relative to
         // the frame (the vertex moves at u, the frame turns at Ω).
         let rate = |k: &FibreKnot| -> f64 {
-            let Some((q, dir, shape)) = k.edge else {
+            let Some(e) = k.edge else {
                 return 0.0;
             };
-            let r = q - x;
-            let v_rel = velocity(q, shape) - u - spin.cross(r);
-            let across = dir.dot(warp.m);
-            if across == 0.0 {
-                return 0.0;
-            }
+            let v_rel = velocity(e.q, e.shape) - u - spin.cross(e.q - x);
             // The crossing stays in the fixed plane: it slides along the
             // edge by what takes it off the plane.
-            let slide = v_rel - dir * (v_rel.dot(warp.m) / across);
-            let (s, c) = k.theta.sin_cos();
-            let e_theta = warp.u * c - warp.p * s;
-            slide.dot(e_theta) / r.length()
+            let slide = v_rel - e.dir * (v_rel.dot(warp.m) * e.inv_across);
+            slide.dot(e.e_theta) * e.inv_r
         };
         let (a_lo, a_hi) = (rate(&warp.lo), rate(&warp.hi));
         let span = warp.hi.theta - warp.lo.theta;
@@ -262,17 +300,15 @@ impl Space {
         }
         let slope = (a_hi - a_lo) / span;
         let alpha = a_lo + slope * (warp.theta - warp.lo.theta);
-        let (s, c) = warp.theta.sin_cos();
-        let e_theta = warp.u * c - warp.p * s;
-        (rigid + e_theta * alpha, slope + alpha * c / s)
+        (rigid + warp.e_w * alpha, slope + alpha * warp.cot)
     }
     // ANCHOR_END: fibre_velocity
 
     /// The meshes whose motion the warp follows.
     pub(super) fn fibre_shapes(&self, warp: &SpaceWarp, mut f: impl FnMut(u32)) {
         for k in [warp.lo, warp.hi] {
-            if let Some((_, _, shape)) = k.edge {
-                f(shape);
+            if let Some(e) = k.edge {
+                f(e.shape);
             }
         }
     }
