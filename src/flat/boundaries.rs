@@ -127,6 +127,7 @@ impl Boundaries for Plane {
     fn warp_velocity(
         &self,
         warp: &FlatWarp,
+        _slot: usize,
         x: DVec2,
         w: DVec2,
         u: DVec2,
@@ -456,7 +457,7 @@ pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
                     DVec2::ZERO
                 }
             };
-            let (wd, _) = plane.warp_velocity(&field, x, w, DVec2::ZERO, 0.0, velocity);
+            let (wd, _) = plane.warp_velocity(&field, 0, x, w, DVec2::ZERO, 0.0, velocity);
             wd.dot(perp(w))
         })
         .collect()

@@ -131,12 +131,13 @@ impl Boundaries for Space {
     fn warp_velocity(
         &self,
         warp: &SpaceWarp,
+        slot: usize,
         x: DVec3,
         w: DVec3,
         u: DVec3,
         spin: DVec3,
         velocity: impl Fn(DVec3, u32) -> DVec3,
     ) -> (DVec3, f64) {
-        self.fibre_velocity(warp, x, w, u, spin, velocity)
+        self.fibre_velocity(warp, slot, x, w, u, spin, velocity)
     }
 }

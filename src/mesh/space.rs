@@ -8,6 +8,7 @@ use super::bvh::TriangleBvh;
 use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
 use super::scene::{Scene, Sensor as SceneSensor};
+use super::warp::{MAX_FIELDS, PoleRule};
 use crate::path::{Geometry, Hit, MediumId, NO_PRIM, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec3;
@@ -61,6 +62,10 @@ pub struct Space {
     /// The hierarchies over all edges and over those of moving meshes.
     pub(super) all_edges: EdgeTree,
     pub(super) moving_edges: EdgeTree,
+    /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
+    /// parameter the index of its rule.
+    pub(super) pole_rules: Vec<PoleRule>,
+    pub(super) slot_field: Vec<u8>,
 }
 
 impl Space {
@@ -171,6 +176,29 @@ impl Space {
         let moving_ids: Vec<u32> = (0..edges.len() as u32)
             .filter(|&i| moving(edges[i as usize].shape))
             .collect();
+        let mut pole_rules = vec![PoleRule::Hashed];
+        let mut slot_field = scene
+            .parameters()
+            .iter()
+            .map(|p| {
+                let rule = PoleRule::of(&p.motion);
+                match pole_rules.iter().position(|r| *r == rule) {
+                    Some(i) => i as u8,
+                    None if pole_rules.len() < MAX_FIELDS => {
+                        pole_rules.push(rule);
+                        (pole_rules.len() - 1) as u8
+                    }
+                    None => 0,
+                }
+            })
+            .collect::<Vec<u8>>();
+        // The pseudo-random family only if some parameter uses it.
+        if !slot_field.contains(&0) && pole_rules.len() > 1 {
+            pole_rules.remove(0);
+            for i in &mut slot_field {
+                *i -= 1;
+            }
+        }
         let all_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, all_ids);
         let moving_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, moving_ids);
         Space {
@@ -188,6 +216,8 @@ impl Space {
             edge_facts,
             all_edges,
             moving_edges,
+            pole_rules,
+            slot_field,
         }
     }
 

@@ -60,9 +60,58 @@ pub struct Crossing {
     inv_across: f64,
 }
 
-/// The warp at a vertex around a sampled direction.
+/// Most fibre families one warp builds (distinct poles); parameters beyond
+/// share the pseudo-random one.
+pub const MAX_FIELDS: usize = 6;
+
+/// How a parameter's fibres are laid out from a vertex `x`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PoleRule {
+    /// A pseudo-random pole fixed by `x` (rotations).
+    Hashed,
+    /// A fixed pole (a translation's direction): every fibre plane holds
+    /// the velocity, so crossings at a silhouette's vertex slide alike.
+    Along(DVec3),
+    /// The pole toward a point (a scale's pivot): every fibre plane holds
+    /// `q − c`, the scale's velocity at each of its points.
+    Toward(DVec3),
+}
+
+impl PoleRule {
+    /// The rule for a parameter's motion.
+    pub fn of(motion: &super::scene::Motion) -> PoleRule {
+        use super::scene::Motion;
+        match *motion {
+            Motion::TranslateX => PoleRule::Along(DVec3::X),
+            Motion::TranslateY => PoleRule::Along(DVec3::Y),
+            Motion::TranslateZ => PoleRule::Along(DVec3::Z),
+            Motion::Scale { pivot } => PoleRule::Toward(pivot.unwrap_or(DVec3::ZERO)),
+            Motion::Rotate { .. } => PoleRule::Hashed,
+        }
+    }
+
+    /// The pole at `x`.
+    #[inline]
+    fn at(&self, x: DVec3) -> DVec3 {
+        match *self {
+            PoleRule::Hashed => pole(x),
+            PoleRule::Along(d) => d,
+            PoleRule::Toward(c) => (c - x).try_normalize().unwrap_or_else(|| pole(x)),
+        }
+    }
+}
+
+/// The warp at a vertex around a sampled direction: one fibre field per
+/// pole rule the scene's parameters use.
 #[derive(Debug, Clone, Copy)]
 pub struct SpaceWarp {
+    fields: [FibreField; MAX_FIELDS],
+    count: usize,
+}
+
+/// The warp of one family of fibres.
+#[derive(Debug, Clone, Copy)]
+pub struct FibreField {
     /// The fibre's plane's unit normal `p × u`.
     m: DVec3,
     /// ω's polar angle, `e_θ` there and `cot θ`.
@@ -96,11 +145,38 @@ fn pole(x: DVec3) -> DVec3 {
 }
 
 impl Space {
-    // ANCHOR: fibre_warp
-    /// The warp at `v` around `w`.
+    /// The warp at `v` around `w`: a field per pole rule.
     pub(super) fn fibre_warp(&self, v: &Vertex<Self>, w: DVec3) -> SpaceWarp {
+        let blank = FibreField {
+            m: DVec3::ZERO,
+            theta: 0.0,
+            e_w: DVec3::ZERO,
+            cot: 0.0,
+            lo: FibreKnot {
+                theta: 0.0,
+                cos: 1.0,
+                edge: None,
+            },
+            hi: FibreKnot {
+                theta: 0.0,
+                cos: 1.0,
+                edge: None,
+            },
+        };
+        let mut warp = SpaceWarp {
+            fields: [blank; MAX_FIELDS],
+            count: self.pole_rules.len(),
+        };
+        for (f, rule) in warp.fields.iter_mut().zip(&self.pole_rules) {
+            *f = self.fibre_field(v, w, rule.at(v.x));
+        }
+        warp
+    }
+
+    // ANCHOR: fibre_warp
+    /// The field of the fibres from the pole `p` at `v` around `w`.
+    fn fibre_field(&self, v: &Vertex<Self>, w: DVec3, p: DVec3) -> FibreField {
         let x = v.x;
-        let p = pole(x);
         let c = w.dot(p).clamp(-1.0, 1.0);
         let perp = w - p * c;
         let s = perp.length();
@@ -112,7 +188,7 @@ impl Space {
         if s < 1e-12 {
             // ω at a pole: the field is the frame's there.
             let theta = c.acos();
-            return SpaceWarp {
+            return FibreField {
                 m: DVec3::ZERO,
                 theta,
                 e_w: DVec3::ZERO,
@@ -157,7 +233,7 @@ impl Space {
                 }),
             }
         };
-        SpaceWarp {
+        FibreField {
             m,
             theta,
             e_w: u * c - p * s,
@@ -268,9 +344,11 @@ impl Space {
 
     // ANCHOR: fibre_velocity
     /// One slot's direction velocity and divergence under the warp.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn fibre_velocity(
         &self,
         warp: &SpaceWarp,
+        slot: usize,
         x: DVec3,
         w: DVec3,
         u: DVec3,
@@ -278,6 +356,8 @@ impl Space {
         velocity: impl Fn(DVec3, u32) -> DVec3,
     ) -> (DVec3, f64) {
         let rigid = spin.cross(w);
+        let field = self.slot_field.get(slot).copied().unwrap_or(0) as usize;
+        let warp = &warp.fields[field.min(warp.count.saturating_sub(1))];
         if warp.m == DVec3::ZERO {
             return (rigid, 0.0);
         }
@@ -306,9 +386,11 @@ impl Space {
 
     /// The meshes whose motion the warp follows.
     pub(super) fn fibre_shapes(&self, warp: &SpaceWarp, mut f: impl FnMut(u32)) {
-        for k in [warp.lo, warp.hi] {
-            if let Some(e) = k.edge {
-                f(e.shape);
+        for field in &warp.fields[..warp.count] {
+            for k in [field.lo, field.hi] {
+                if let Some(e) = k.edge {
+                    f(e.shape);
+                }
             }
         }
     }

@@ -49,7 +49,7 @@ fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>
                 G::V::ZERO
             }
         };
-        let (wd, div) = g.warp_velocity(&field, v.x, w, s.u, s.spin, velocity);
+        let (wd, div) = g.warp_velocity(&field, j, v.x, w, s.u, s.spin, velocity);
         s.score += div + v.lobe.dlog(w, wd - G::V::turn(s.spin, w));
         s.wd = wd;
     }

@@ -320,13 +320,16 @@ pub trait Boundaries: Geometry {
         Self: Sized;
     /// Calls `f` with every shape whose motion the warp at `w` follows.
     fn warp_shapes(&self, warp: &Self::Warp, f: impl FnMut(u32));
-    /// One slot's velocity of the direction `w` under the warp, and the
+    /// Slot `slot`'s velocity of the direction `w` under the warp, and the
     /// warp's divergence there: `u` is the vertex velocity, `spin` the
     /// frame's turn rate, `velocity(q, k)` the velocity of point `q` of
-    /// shape `k`.
+    /// shape `k`. (A geometry may build a different field per slot: 3D
+    /// aligns its fibres with each parameter's motion.)
+    #[allow(clippy::too_many_arguments)]
     fn warp_velocity(
         &self,
         warp: &Self::Warp,
+        slot: usize,
         x: Self::V,
         w: Self::V,
         u: Self::V,
