@@ -9,11 +9,16 @@
 //! - [`space`]: the scene behind the path core's `Geometry`; [`lobe`]: the
 //!   3D lobes; [`boundaries`]: the edges behind `Boundaries`; [`warp`]: the
 //!   expectation method's fibre warp;
-//! - [`methods`]: the estimators; [`exact`]: closed-form references.
+//! - [`methods`]: the estimators; [`exact`]: closed-form references;
+//!   [`cases`]: scenes built in code for the figures and `geosens compare`
+//!   (the figures themselves: `figures`, with the `figures` feature).
 pub mod boundaries;
 pub mod bvh;
 pub mod edges;
+pub mod cases;
 pub mod exact;
+#[cfg(feature = "figures")]
+pub mod figures;
 pub mod file;
 pub mod lobe;
 pub mod methods;

@@ -193,6 +193,7 @@ pub(super) fn compare_command(
     for (m, (seconds, z, bad)) in Method::UNBIASED.iter().zip(totals) {
         writeln!(out, "{:<12} {seconds:>9.3} {z:>7.1} {bad:>11}", m.name())?;
     }
+    mesh_table(&cfg, out)?;
     writeln!(
         out,
         "total wall time {:.2} s",
@@ -211,6 +212,7 @@ pub(super) fn compare_command(
         let start = Instant::now();
         let mut written = figures::all(&opts)?;
         written.extend(geosens::flat::figures::all(&opts)?);
+        written.extend(geosens::mesh::figures::all(&opts)?);
         writeln!(
             out,
             "\nwrote {} files to {} in {:.1} s",
@@ -226,6 +228,108 @@ pub(super) fn compare_command(
              feature (on by default; build without --no-default-features)",
             args.figures.display()
         );
+    }
+    Ok(())
+}
+
+/// One cell of the 3D table: `mean ± stderr z` with the signed z-score
+/// against the closed form, `!` if the error bar is unreliable.
+fn mesh_cell(e: &Estimate, exact: f64) -> String {
+    let z = (e.mean - exact) / e.stderr;
+    let z = if e.mean == exact {
+        "0.0".to_owned()
+    } else if z.is_finite() {
+        format!("{z:+.1}")
+    } else {
+        "-".to_owned()
+    };
+    format!(
+        "{:>11.6} ± {:<7.1e} z {:>5}{}",
+        e.mean,
+        e.stderr,
+        z,
+        if e.is_reliable() { "" } else { "!" }
+    )
+}
+
+/// The 3D rows of `geosens compare`: every method on two occluder scenes
+/// (a black triangle, a black box, under the unit-square lamp) against the
+/// closed forms of `geosens::mesh::exact`, one run per method giving `E`
+/// and every `∂E/∂π`.
+fn mesh_table(cfg: &RunConfig, out: &mut impl Write) -> Result<(), Box<dyn std::error::Error>> {
+    use geosens::mesh::cases::{TriangleOccluder, box_shape, lamp, up};
+    use geosens::mesh::exact::BoxScene;
+    use geosens::mesh::{Parameter, Scene, Surface};
+    use glam::DVec3;
+    let t = TriangleOccluder::NOMINAL;
+    let (e, s) = t.exact()?;
+    let triangle = (
+        "black triangle (centre (0.2, 0.05, 1), circumradius 0.2, first vertex at 0.3 rad)",
+        t.scene(&[0, 1, 2])?,
+        e,
+        s.to_vec(),
+    );
+    let b = BoxScene::shipped(DVec3::new(0.2, -0.1, 1.0), 0.3);
+    let names = ["box_tx", "box_ty", "box_tz", "box_rot", "box_scale"];
+    let parameters = names
+        .iter()
+        .zip(b.motions())
+        .map(|(n, m)| Parameter {
+            name: (*n).into(),
+            shape: "box".into(),
+            motion: m,
+        })
+        .collect();
+    let cube = box_shape("box", b.corners(), Surface::Absorber, None);
+    let boxed = (
+        "black cube (side 0.3, centred at (0.2, -0.1, 1))",
+        Scene::new(vec![lamp(), cube], parameters, up())?,
+        b.irradiance()?,
+        b.sensitivities()?.to_vec(),
+    );
+    for (what, scene, e, s) in [triangle, boxed] {
+        let scene = std::sync::Arc::new(scene);
+        writeln!(
+            out,
+            "\n3D: {what} at z ≈ 1 under the unit-square lamp (radiance 1) at z = 2, \
+             irradiance at the origin (normal +z); {} paths per run, seed {}",
+            cfg.paths, cfg.seed
+        )?;
+        writeln!(
+            out,
+            "{:<16} {:>11} {:<12} {:<38} {:>9}",
+            "quantity", "closed form", "method", "estimate", "time [s]"
+        )?;
+        let mut runs = Vec::new();
+        for m in Method::ALL {
+            runs.push(run(
+                m.estimator(std::sync::Arc::clone(&scene))?.as_ref(),
+                cfg,
+            )?);
+        }
+        let mut quantities = vec![(Quantity::Intensity, "E".to_owned(), e)];
+        for (p, &x) in scene.parameters().iter().zip(&s) {
+            quantities.push((Quantity::sensitivity(&p.name), format!("∂E/∂{}", p.name), x));
+        }
+        for (q, label, exact) in &quantities {
+            let mut first = true;
+            for r in &runs {
+                let Some(est) = r.get(q) else { continue };
+                let (l, x) = if first {
+                    (label.as_str(), format!("{exact:>11.6}"))
+                } else {
+                    ("", String::new())
+                };
+                first = false;
+                writeln!(
+                    out,
+                    "{l:<16} {x:>11} {:<12} {:<38} {:>9.3}",
+                    r.method,
+                    mesh_cell(&est, *exact),
+                    r.seconds
+                )?;
+            }
+        }
     }
     Ok(())
 }

@@ -11,8 +11,9 @@
 //!   triangle-mesh scene file (gradient axes x, y, z);
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
 //!   and thick rods at a few probes and prints them beside the exact solution,
-//!   then writes the rod's figures and flatland's (`flat_*`) (with the
-//!   `figures` feature, on by default).
+//!   then every method on two 3D occluder scenes beside their closed forms,
+//!   then writes the rod's figures, flatland's (`flat_*`) and the 3D ones
+//!   (`mesh_*`) (with the `figures` feature, on by default).
 //!
 //! Bad input exits with status 1 and `error: …` naming the value (clap's own
 //! parse errors exit with status 2).
@@ -44,8 +45,9 @@ struct Cli {
 enum Command {
     /// Estimate I, ∂I/∂length (and ∂I/∂x) at one probe on a rod.
     Rod(RodArgs),
-    /// Compare the four methods with the exact solution on the paper's rods,
-    /// then write the rod's figures and flatland's.
+    /// Compare the four methods with the exact solution on the paper's rods
+    /// and with the closed forms on two 3D occluder scenes, then write the
+    /// rod's figures, flatland's and the 3D ones.
     Compare(CompareArgs),
     /// Estimate I and ∂I/∂π for every parameter of a flatland scene file.
     Flat(SceneArgs),

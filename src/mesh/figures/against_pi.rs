@@ -1,0 +1,308 @@
+//! 3D estimates against the parameter value over the closed form: the black
+//! triangle occluder ([`TriangleOccluder::NOMINAL`]) under the unit-square
+//! lamp, irradiance at the origin. For each motion (translation along x,
+//! rotation about the vertical through its centre, scale about its centre)
+//! the occluder is moved to [`VALUES`] values of `π` and every method run
+//! there: `E` from the intensity estimator, `∂E/∂π` from expectation,
+//! rendering, transport and finite differences, over
+//! [`occluded_irradiance_with_gradient`](crate::mesh::exact::occluded_irradiance_with_gradient)
+//! on a fine grid. The translation slides the shadow (twice the triangle's
+//! size on the lamp's plane) from across the lamp's left edge to off its
+//! right edge: `E` is C¹ there (a shadow vertex crossing a lamp edge is a
+//! kink of `∂E/∂π`, not a jump, as no shadow edge is parallel to a lamp
+//! edge).
+//!
+//! The scale's `∂E/∂π` is the derivative of the plotted `E(π)` (the
+//! triangle's size `r₀(1 + π)`): the estimators differentiate a scale about
+//! the *current* size, `r ∂E/∂r`, so their estimates (and the closed form's)
+//! are divided by `1 + π`.
+use super::{
+    DERIVATIVE_METHODS, FigureOptions, REFERENCE_COLOR, color, get, label, run_method, save, z,
+};
+use crate::error::Error;
+use crate::estimator::Quantity;
+use crate::mesh::cases::TriangleOccluder;
+use crate::method::Method;
+use crate::plot::{Figure, Panel, Series};
+use serde::Serialize;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// One parameter swept over a range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sweep {
+    /// Index into [`TriangleOccluder::PARAMETERS`].
+    pub parameter: usize,
+    /// First and last value of `π`.
+    pub range: (f64, f64),
+}
+
+/// The sweeps, one column of panels each: the translation from the shadow
+/// across the lamp's left edge (π = −0.45) to just off its right edge; a
+/// third of a turn and more; the scale from 0.4 to 1.9 times.
+pub const SWEEPS: [Sweep; 3] = [
+    Sweep {
+        parameter: 0,
+        range: (-0.45, 0.35),
+    },
+    Sweep {
+        parameter: 1,
+        range: (-1.2, 1.2),
+    },
+    Sweep {
+        parameter: 2,
+        range: (-0.6, 0.9),
+    },
+];
+
+/// Values of `π` per sweep (ends included).
+pub const VALUES: usize = 13;
+
+/// Points of the closed-form curves per sweep.
+pub const CURVE_POINTS: usize = 481;
+
+/// Paths per run (times the effort).
+pub const PATHS: u64 = 100_000;
+
+/// Base of the seed salts of this figure (distinct from the other figures').
+const SALT: u64 = 70_000_000;
+
+/// One estimate at one value of `π`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Record {
+    /// The parameter.
+    pub parameter: &'static str,
+    /// Its value.
+    pub pi: f64,
+    /// Method name.
+    pub method: &'static str,
+    /// `"E"` or `"dE/dπ"`.
+    pub quantity: &'static str,
+    /// Paths sampled.
+    pub paths: u64,
+    /// The estimate.
+    pub mean: f64,
+    /// Its standard error.
+    pub stderr: f64,
+    /// Relative variance of the variance.
+    pub vov: f64,
+    /// The closed form.
+    pub exact: f64,
+    /// `(mean − exact) / stderr` (see [`super::z`]).
+    pub z: Option<f64>,
+}
+
+/// The closed-form curve of one sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Curve {
+    /// The parameter.
+    pub parameter: &'static str,
+    /// Values of `π`.
+    pub pi: Vec<f64>,
+    /// `E(π)`.
+    pub e: Vec<f64>,
+    /// `∂E/∂π(π)`.
+    pub de: Vec<f64>,
+}
+
+/// The numbers behind `mesh_against_pi.{png,svg}`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AgainstPi {
+    /// The nominal occluder: centre, circumradius, angle of its first
+    /// vertex.
+    pub occluder: ([f64; 3], f64, f64),
+    /// Every estimate.
+    pub records: Vec<Record>,
+    /// The closed-form curves.
+    pub curves: Vec<Curve>,
+}
+
+/// `n` evenly spaced values over `range`, ends included.
+fn grid((lo, hi): (f64, f64), n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+        .collect()
+}
+
+/// `E` and `∂E/∂π` of the plotted curve at `π` (see the module docs for the
+/// scale), and the factor applied to the estimators' derivative.
+fn exact_at(sweep: &Sweep, pi: f64) -> Result<(f64, f64, f64), Error> {
+    let k = sweep.parameter;
+    let (e, d) = TriangleOccluder::NOMINAL.moved(k, pi).exact()?;
+    let factor = if k == 2 { 1.0 / (1.0 + pi) } else { 1.0 };
+    Ok((e, d[k] * factor, factor))
+}
+
+fn curve(sweep: &Sweep) -> Result<Curve, Error> {
+    let pi = grid(sweep.range, CURVE_POINTS);
+    let mut e = Vec::with_capacity(pi.len());
+    let mut de = Vec::with_capacity(pi.len());
+    for &p in &pi {
+        let (v, d, _) = exact_at(sweep, p)?;
+        e.push(v);
+        de.push(d);
+    }
+    Ok(Curve {
+        parameter: TriangleOccluder::PARAMETERS[sweep.parameter],
+        pi,
+        e,
+        de,
+    })
+}
+
+fn measure(
+    opts: &FigureOptions,
+    sweep: &Sweep,
+    salt: &mut u64,
+    bar: &indicatif::ProgressBar,
+) -> Result<Vec<Record>, Error> {
+    let k = sweep.parameter;
+    let name = TriangleOccluder::PARAMETERS[k];
+    let mut records = Vec::new();
+    for pi in grid(sweep.range, VALUES) {
+        let scene = Arc::new(TriangleOccluder::NOMINAL.moved(k, pi).scene(&[k])?);
+        let (e, de, factor) = exact_at(sweep, pi)?;
+        for method in std::iter::once(Method::Intensity).chain(DERIVATIVE_METHODS) {
+            *salt += 1;
+            let r = run_method(opts, method, &scene, PATHS, *salt, opts.threads)?;
+            let (q, quantity, exact, f) = match method {
+                Method::Intensity => (Quantity::Intensity, "E", e, 1.0),
+                _ => (Quantity::sensitivity(name), "dE/dπ", de, factor),
+            };
+            let est = get(&r, &q)?;
+            let (mean, stderr) = (est.mean * f, est.stderr * f);
+            records.push(Record {
+                parameter: name,
+                pi,
+                method: method.name(),
+                quantity,
+                paths: r.paths,
+                mean,
+                stderr,
+                vov: est.vov,
+                exact,
+                z: z(mean, stderr, exact),
+            });
+            bar.inc(1);
+        }
+    }
+    Ok(records)
+}
+
+/// Axis label of parameter `k`.
+fn axis(k: usize) -> &'static str {
+    match k {
+        0 => "π = translation along x",
+        1 => "π = rotation about the vertical (rad)",
+        _ => "π = scale − 1",
+    }
+}
+
+/// The two panels of one sweep: `E` and `∂E/∂π`, legends off (the figure's
+/// legend has a panel of its own).
+fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
+    let step = (sweep.range.1 - sweep.range.0) / (VALUES - 1) as f64;
+    [("E", "E (irradiance)"), ("dE/dπ", "∂E/∂π")].map(|(quantity, y_label)| {
+        let ys = if quantity == "E" { &curve.e } else { &curve.de };
+        let xy = curve.pi.iter().copied().zip(ys.iter().copied()).collect();
+        let mut series = vec![Series::line("", REFERENCE_COLOR, xy)];
+        let methods: Vec<Method> = if quantity == "E" {
+            vec![Method::Intensity]
+        } else {
+            DERIVATIVE_METHODS.to_vec()
+        };
+        for (i, &method) in methods.iter().enumerate() {
+            // Side by side, so that the error bars do not hide each other.
+            let offset = (i as f64 - 0.5 * (methods.len() - 1) as f64) * 0.1 * step;
+            let points = records
+                .iter()
+                .filter(|r| r.method == method.name() && r.quantity == quantity)
+                .map(|r| (r.pi + offset, r.mean, r.stderr))
+                .collect();
+            series.push(Series::points("", color(method), points));
+        }
+        Panel {
+            title: format!(
+                "triangle occluder: {} against {}",
+                quantity.replace("dE/dπ", "∂E/∂π"),
+                curve.parameter
+            ),
+            x_label: axis(sweep.parameter).into(),
+            y_label: y_label.into(),
+            series,
+            ..Panel::default()
+        }
+    })
+}
+
+/// The legend panel: the closed form and every method.
+fn legend() -> Panel {
+    let mut series = vec![Series::line("closed form", REFERENCE_COLOR, vec![])];
+    for method in std::iter::once(Method::Intensity).chain(DERIVATIVE_METHODS) {
+        series.push(Series::points(&label(method), color(method), vec![]));
+    }
+    Panel {
+        title: "black triangle at z = 1 under the unit lamp at z = 2".into(),
+        series,
+        legend_only: true,
+        ..Panel::default()
+    }
+}
+
+/// `E` and `∂E/∂π` against `π` for the black triangle occluder's
+/// translation along x, rotation and scale ([`SWEEPS`], columns; `E` on the
+/// top row, `∂E/∂π` below, the legend in a panel of its own at the right),
+/// every Monte Carlo method as markers with ±σ bars ([`PATHS`] paths per
+/// run on `opts.threads`) over the closed form as a line. Writes
+/// `mesh_against_pi.{png,svg,json}`:
+///
+/// ```text
+/// cargo run --release --example fig_mesh_against_pi -- [OUT_DIR] [EFFORT]
+/// ```
+pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
+    let runs = SWEEPS.len() * VALUES * (1 + DERIVATIVE_METHODS.len());
+    let bar = opts.bar(runs as u64, "mesh: against π");
+    let mut salt = SALT;
+    let mut records = Vec::new();
+    let mut curves = Vec::new();
+    let mut top = Vec::new();
+    let mut bottom = Vec::new();
+    for sweep in &SWEEPS {
+        let c = curve(sweep)?;
+        let r = measure(opts, sweep, &mut salt, &bar)?;
+        let [e, de] = panels(sweep, &c, &r);
+        top.push(e);
+        bottom.push(de);
+        records.extend(r);
+        curves.push(c);
+    }
+    bar.finish();
+    top.push(legend());
+    top.extend(bottom);
+    let mut figure = Figure::new(top, SWEEPS.len() + 1);
+    figure.panel_size = (560, 440);
+    let o = TriangleOccluder::NOMINAL;
+    let numbers = AgainstPi {
+        occluder: (o.centre.to_array(), o.radius, o.angle),
+        records,
+        curves,
+    };
+    save(opts, "against_pi", &figure, &numbers)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweeps_stay_valid() {
+        for sweep in &SWEEPS {
+            for pi in grid(sweep.range, VALUES) {
+                let t = TriangleOccluder::NOMINAL.moved(sweep.parameter, pi);
+                let scene = Arc::new(t.scene(&[sweep.parameter]).unwrap());
+                assert!(Method::Fd.estimator(scene).is_ok(), "{sweep:?} at {pi}");
+                assert!(exact_at(sweep, pi).unwrap().1.is_finite());
+            }
+        }
+    }
+}
