@@ -101,6 +101,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
         slots,
         scheme,
         names,
+        caveats: Vec::new(),
     }
 }
 

@@ -64,6 +64,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Spac
         }
     }
     let shapes = scene.shapes().len();
+    let caveats = kinks(&scene);
     let geometry = Space::new(scene);
     let slots = Slots::new(&geometry, shapes, gradient);
     DerivativeEstimator {
@@ -71,7 +72,44 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Spac
         slots,
         scheme,
         names,
+        caveats,
     }
+}
+
+/// Where `I` may not be differentiable: the sensor lies in the plane of a
+/// face of a moved mesh (within 10⁻⁹ of the scene's size) and the motion
+/// moves the face across that plane, so the face, seen edge-on, turns to
+/// face the sensor from one side or the other (a kink: the two one-sided
+/// derivatives differ, and the boundary terms see the face edge-on). One
+/// caveat per parameter of such a mesh.
+pub fn kinks(scene: &Scene) -> Vec<(Quantity, String)> {
+    let x = scene.sensor().point();
+    let tolerance = 1e-9 * scene.size();
+    let mut out = Vec::new();
+    for (j, p) in scene.parameters().iter().enumerate() {
+        let shape = &scene.shapes()[scene.parameter_shape(j) as usize];
+        let edge_on = (0..shape.triangles.len()).find(|&i| {
+            let t = shape.triangle(i);
+            let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+            let across = t.iter().any(|&q| {
+                let v = p.motion.velocity(q);
+                v.dot(n).abs() > 1e-9 * v.length()
+            });
+            n != glam::DVec3::ZERO && n.dot(x - t[0]).abs() <= tolerance && across
+        });
+        if let Some(i) = edge_on {
+            out.push((
+                Quantity::sensitivity(&p.name),
+                format!(
+                    "the sensor lies in the plane of triangle {i} of mesh {:?}: the face is seen \
+                     edge-on, I may have a kink along {:?} (the one-sided derivatives differ) \
+                     and the estimate is neither of them",
+                    shape.name, p.name
+                ),
+            ));
+        }
+    }
+    out
 }
 
 /// Central differences with common random numbers: `I` on the nominal
@@ -109,6 +147,13 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
             minus: Method::Intensity.estimator(minus)?,
             half_step: h,
         });
+    }
+    for (q, why) in kinks(scene) {
+        if let Quantity::Sensitivity(name) = q
+            && !caveats.iter().any(|c: &(String, String)| c.0 == name)
+        {
+            caveats.push((name, why));
+        }
     }
     let mut fd =
         CentralDifference::new(Some(Method::Intensity.estimator(Arc::clone(scene))?), pairs)?;

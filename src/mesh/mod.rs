@@ -14,8 +14,8 @@
 //!   (the figures themselves: `figures`, with the `figures` feature).
 pub mod boundaries;
 pub mod bvh;
-pub mod edges;
 pub mod cases;
+pub mod edges;
 pub mod exact;
 #[cfg(feature = "figures")]
 pub mod figures;

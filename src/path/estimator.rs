@@ -75,6 +75,8 @@ pub struct DerivativeEstimator<G> {
     pub scheme: Scheme,
     /// Names of the parameters, then of the gradient axes.
     pub names: Vec<Quantity>,
+    /// Warnings about particular quantities (see [`Estimator::caveats`]).
+    pub caveats: Vec<(Quantity, String)>,
 }
 
 impl<G: Boundaries> DerivativeEstimator<G> {
@@ -124,6 +126,9 @@ impl<G: Boundaries> Estimator for DerivativeEstimator<G> {
         std::iter::once(Quantity::Intensity)
             .chain(self.names.iter().cloned())
             .collect()
+    }
+    fn caveats(&self) -> Vec<(Quantity, String)> {
+        self.caveats.clone()
     }
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
         self.path(rng, &mut Scratch::default(), weights);
