@@ -373,3 +373,147 @@ fn a_face_seen_edge_on_is_a_caveat_not_a_number() {
         assert!(s.z_score(exact) < 4.0, "{m}: {s:?} vs {exact}");
     }
 }
+
+/// The occluder scene: a black triangle at z = 1 under the unit
+/// lamp, translated, rotated and scaled, irradiance at several points of
+/// the plane z = 0 (not only under the lamp's centre), every derivative
+/// method against the closed form.
+#[test]
+fn a_triangle_occluder_seen_from_points_on_the_floor() {
+    use geosens::mesh::exact::{occluded_irradiance_with_gradient, sensitivity};
+    let c = DVec3::new(0.15, 0.05, 1.0);
+    let tri: Vec<DVec3> = (0..3)
+        .map(|k| {
+            let a = 2.0 * std::f64::consts::PI * k as f64 / 3.0 + 0.3;
+            c + 0.22 * DVec3::new(a.cos(), a.sin(), 0.0)
+        })
+        .collect();
+    let motions = [
+        ("tx", Motion::TranslateX),
+        ("tz", Motion::TranslateZ),
+        (
+            "rot",
+            Motion::Rotate {
+                axis: DVec3::new(0.2, -0.4, 1.0).normalize(),
+                pivot: Some(c),
+            },
+        ),
+        ("scale", Motion::Scale { pivot: Some(c) }),
+    ];
+    let lamp_poly = lamp().vertices.clone();
+    for (i, x) in [
+        DVec3::ZERO,
+        DVec3::new(0.3, -0.2, 0.0),
+        DVec3::new(-0.45, 0.35, 0.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let occ = Shape {
+            name: "tri".into(),
+            vertices: tri.clone(),
+            triangles: vec![[0, 1, 2]],
+            surface: Surface::Absorber,
+            medium: None,
+        };
+        let sensor = Sensor::Irradiance {
+            point: x,
+            normal: DVec3::Z,
+        };
+        let scene =
+            Arc::new(Scene::new(vec![lamp(), occ], params("tri", &motions), sensor).unwrap());
+        let (e, g) = occluded_irradiance_with_gradient(x, DVec3::Z, &lamp_poly, &tri, 1.0).unwrap();
+        for m in [Method::Rendering, Method::Transport, Method::Expectation] {
+            let r = estimate(&scene, m, 150_000, 20 + i as u64);
+            let ie = r.get(&Quantity::Intensity).unwrap();
+            assert!(ie.z_score(e) < 4.0, "{m} at {x}: {ie:?} vs {e}");
+            for (name, motion) in motions {
+                let exact = sensitivity(&g, &tri, motion);
+                let a = r.get(&Quantity::sensitivity(name)).unwrap();
+                assert!(
+                    a.z_score(exact) < 4.0,
+                    "{m} {name} at {x}: {a:?} vs {exact}"
+                );
+            }
+        }
+    }
+}
+
+/// Flatland as a limit: a lamp strip and an occluder strip 2000 long (an
+/// infinitely long prism seen from its middle) give `π/2` times the
+/// flatland irradiance of their cross-section (the view factor of an
+/// infinite strip is half the difference of the sines, flatland's
+/// irradiance that difference), and the same for every derivative: the 3D
+/// estimators against flatland's closed form for `scenes/occluder.toml`.
+#[test]
+fn a_long_prism_is_flatland_times_pi_over_two() {
+    use geosens::flat::exact::Reference;
+    let flat = geosens::flat::file::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/occluder.toml"),
+    )
+    .unwrap();
+    let reference = Reference::for_scene(&flat).unwrap();
+    let half = 1000.0;
+    let strip = |name: &str, x0: f64, x1: f64, z: f64, surface: Surface| Shape {
+        name: name.into(),
+        vertices: vec![
+            DVec3::new(x0, -half, z),
+            DVec3::new(x1, -half, z),
+            DVec3::new(x1, half, z),
+            DVec3::new(x0, half, z),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        surface,
+        medium: None,
+    };
+    let pivot = DVec3::new(-0.2, 0.0, 1.0);
+    // Flatland's (x, y) is (x, z) here; its counter-clockwise turn is a
+    // rotation about −y.
+    let motions = [
+        ("occluder_tx", Motion::TranslateX),
+        ("occluder_ty", Motion::TranslateZ),
+        (
+            "occluder_rotate",
+            Motion::Rotate {
+                axis: -DVec3::Y,
+                pivot: Some(pivot),
+            },
+        ),
+    ];
+    let scene = Arc::new(
+        Scene::new(
+            vec![
+                strip("lamp", -1.0, 1.0, 2.0, Surface::Emitter { radiance: 1.0 }),
+                strip("occluder", -0.6, 0.2, 1.0, Surface::Absorber),
+            ],
+            params("occluder", &motions),
+            up(),
+        )
+        .unwrap(),
+    );
+    let k = std::f64::consts::FRAC_PI_2;
+    for m in [
+        Method::Intensity,
+        Method::Rendering,
+        Method::Transport,
+        Method::Expectation,
+    ] {
+        let r = estimate(&scene, m, 200_000, 30);
+        let i = r.get(&Quantity::Intensity).unwrap();
+        assert!(
+            i.z_score(k * reference.value()) < 4.0,
+            "{m}: {i:?} vs {}",
+            k * reference.value()
+        );
+        if m == Method::Intensity {
+            continue;
+        }
+        for (j, (name, _)) in motions.iter().enumerate() {
+            let exact = k * reference.derivative(j);
+            let a = r.get(&Quantity::sensitivity(name)).unwrap();
+            eprintln!("{m} {name}: {:.5} ± {:.5} vs {exact:.5}", a.mean, a.stderr);
+            assert!(a.z_score(exact) < 4.0, "{m} {name}: {a:?} vs {exact}");
+            assert!(a.stderr < 0.05 * exact.abs().max(0.02), "{m} {name}: {a:?}");
+        }
+    }
+}

@@ -5,12 +5,13 @@
 //! crease (each side sees another face: a jump for a reflector only).
 //!
 //! The boundary term of the directional integral is a line integral along
-//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`. An edge is drawn with
-//! probability proportional to its weight (length × dihedral turn / π, a
-//! binary search in the cumulative weights), a point uniformly along it
-//! (the same uniform number, rescaled), and the arc-length Jacobian
-//! `dl/ds = |ω × ê| / r` goes into the inverse density, so the path core's
-//! corner term (`rendering::corner_jump`) is, unchanged, the edge term.
+//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`. An edge is drawn from the
+//! edge hierarchy ([`super::edges`]: by weight, length × dihedral turn / π,
+//! among the edges that can be discontinuities from `x`), a point uniformly
+//! in angle along its arc (the same uniform number, rescaled), and the
+//! inverse density per unit arc length, `Γ / p(e)` for an arc of angle `Γ`,
+//! goes into the boundary point, so the path core's corner term
+//! (`rendering::corner_jump`) is, unchanged, the edge term.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
 use super::space::Space;
 use super::warp::SpaceWarp;
@@ -54,21 +55,34 @@ impl Boundaries for Space {
         let (index, p, along) =
             tree.sample(x, u, &self.edges, &self.edge_facts, &self.edge_weight)?;
         let edge = &self.edges[index as usize];
+        // The point: uniform in angle along the edge's arc seen from x, so
+        // a long edge is sampled where it subtends the most (uniform in
+        // length, its far parts would be drawn as often as its near ones
+        // for a vanishing share of the arc).
+        let (ra, rb) = (edge.a - x, edge.b - x);
+        let n = ra.cross(rb);
+        let (sin_g, cos_g) = (n.length(), ra.dot(rb));
+        let arc = sin_g.atan2(cos_g);
+        if !(arc > 0.0) || sin_g == 0.0 {
+            return None; // seen end-on: no arc
+        }
+        let n = n / sin_g;
+        let wa = ra.normalize();
+        let t = n.cross(wa);
+        let (s, c) = (along * arc).sin_cos();
+        let w = wa * c + t * s;
+        // Where the ray along w meets the edge's line, in the plane (x, a, b).
         let d = edge.b - edge.a;
-        let q = edge.a + d * along;
-        let r = q - x;
-        let dist = r.length();
-        let len = d.length();
-        // dl = |ω × ê| / r ds on the sphere.
-        let jacobian = (r / dist).cross(d / len).length() / dist;
-        if jacobian.is_nan() || jacobian <= 0.0 || jacobian.is_infinite() {
+        let tau = (-(ra.cross(w).dot(n)) / d.cross(w).dot(n)).clamp(0.0, 1.0);
+        let q = edge.a + d * tau;
+        if !q.is_finite() {
             return None;
         }
         Some(BoundaryPoint {
             q,
             shape: edge.shape,
             index,
-            inv_pdf: len * jacobian / p,
+            inv_pdf: arc / p,
         })
     }
     // ANCHOR_END: sample_boundary

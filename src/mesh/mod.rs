@@ -3,7 +3,7 @@
 //! book's 3D chapter derives what differs from flatland: silhouette edges
 //! instead of corners, and a warp on the sphere.
 //!
-//! - [`scene`]: the validated scene; [`file`]: its TOML/JSON file form
+//! - [`scene`]: the validated scene; [`file`](mod@file): its TOML/JSON file form
 //!   (meshes inline or in OBJ files);
 //! - [`bvh`]: ray casting through obvhs, every hit re-tested in f64;
 //! - [`space`]: the scene behind the path core's `Geometry`; [`lobe`]: the
