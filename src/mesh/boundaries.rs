@@ -63,7 +63,7 @@ impl Boundaries for Space {
         let n = ra.cross(rb);
         let (sin_g, cos_g) = (n.length(), ra.dot(rb));
         let arc = sin_g.atan2(cos_g);
-        if !(arc > 0.0) || sin_g == 0.0 {
+        if arc.is_nan() || arc <= 0.0 || sin_g == 0.0 {
             return None; // seen end-on: no arc
         }
         let n = n / sin_g;
