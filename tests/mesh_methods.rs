@@ -517,3 +517,49 @@ fn a_long_prism_is_flatland_times_pi_over_two() {
         }
     }
 }
+
+/// A black cube inside a big box of fog (a mesh inside a medium), the
+/// sensor in the fog too: the cube's sensitivities against finite
+/// differences (the edge terms see through the medium, and the nested
+/// paths start inside it).
+#[test]
+fn a_mesh_inside_a_medium_matches_finite_differences() {
+    let fog = Medium {
+        ks: 0.6,
+        ke: 0.9,
+        g: -0.2,
+    };
+    let motions = [
+        ("tx", Motion::TranslateX),
+        ("tz", Motion::TranslateZ),
+        ("scale", Motion::Scale { pivot: None }),
+    ];
+    let shapes = vec![
+        lamp(),
+        cube(
+            "fog",
+            DVec3::new(0.0, 0.0, 0.9),
+            1.0,
+            Surface::Transparent,
+            Some(fog),
+        ),
+        cube("occ", DVec3::new(0.15, -0.1, 1.0), 0.2, Surface::Absorber, None),
+    ];
+    let scene = Arc::new(Scene::new(shapes, params("occ", &motions), up()).unwrap());
+    assert_eq!(scene.sensor_medium(), Some(1));
+    let fd = estimate(&scene, Method::Fd, 3_000_000, 40);
+    for m in [Method::Rendering, Method::Transport, Method::Expectation] {
+        let r = estimate(&scene, m, 150_000, 41);
+        for (name, _) in motions {
+            let q = Quantity::sensitivity(name);
+            let (a, b) = (r.get(&q).unwrap(), fd.get(&q).unwrap());
+            let z = (a.mean - b.mean) / a.stderr.hypot(b.stderr);
+            eprintln!(
+                "{m} {name}: {:.5} ± {:.5} vs fd {:.5} ± {:.5} (z {z:.2})",
+                a.mean, a.stderr, b.mean, b.stderr
+            );
+            assert!(z.abs() < 4.0, "{m} {name}: {a:?} vs fd {b:?}");
+            assert!(b.stderr < 0.1 * b.mean.abs(), "fd {name}: {b:?}");
+        }
+    }
+}
