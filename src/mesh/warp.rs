@@ -21,10 +21,14 @@
 //! but `V` is tangent to the fibres, so its normal component does not jump.
 //! The divergence on the unit sphere is `∂α/∂θ + α cot θ`.
 //!
-//! The pole is a pseudo-random direction fixed by the vertex's position, so
-//! no edge of a scene lies along the fibres by construction (an edge
-//! exactly on a fibre could not be moved by `V`; nearly on one, `α` is
-//! large: the method's heavy tail). Book: chapter "Three dimensions",
+//! The pole: for a translation's slots, the translation's direction (every
+//! fibre plane then holds the velocity, so the two crossings of a
+//! silhouette's vertex slide alike and no knots with different rates meet
+//! there); for the other slots a pseudo-random direction fixed by the
+//! vertex's position, so no edge of a scene lies along the fibres by
+//! construction (an edge exactly on a fibre could not be moved by `V`;
+//! nearly on one, `α` is large: one of the method's heavy tails). One field
+//! per pole rule ([`PoleRule`]), each with its own knot search. Book: chapter "Three dimensions",
 //! section "A warp on the sphere".
 use super::space::Space;
 use crate::path::NO_PRIM;
