@@ -33,7 +33,6 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::hint::black_box;
 use std::time::Duration;
@@ -46,64 +45,10 @@ const NONE: u32 = u32::MAX;
 
 type Tri = [DVec3; 3];
 
-/// The unit icosphere subdivided `n` times, welded: `20·4ⁿ` triangles.
+/// The unit icosphere subdivided `n` times (`geosens::mesh::cases`), as
+/// triangles.
 fn icosphere(n: u32) -> Vec<Tri> {
-    let g = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        (-1.0, g, 0.0),
-        (1.0, g, 0.0),
-        (-1.0, -g, 0.0),
-        (1.0, -g, 0.0),
-        (0.0, -1.0, g),
-        (0.0, 1.0, g),
-        (0.0, -1.0, -g),
-        (0.0, 1.0, -g),
-        (g, 0.0, -1.0),
-        (g, 0.0, 1.0),
-        (-g, 0.0, -1.0),
-        (-g, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let mut f: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..n {
-        let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
-        let mut m = |a: usize, b: usize, v: &mut Vec<DVec3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                v.push((0.5 * (v[a] + v[b])).normalize());
-                v.len() - 1
-            })
-        };
-        f = f
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let (ab, bc, ca) = (m(a, b, &mut v), m(b, c, &mut v), m(c, a, &mut v));
-                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
-            })
-            .collect();
-    }
+    let (v, f) = geosens::mesh::cases::icosphere(n);
     f.iter().map(|t| t.map(|i| v[i])).collect()
 }
 

@@ -74,29 +74,7 @@ fn with_occluders(occluders: Vec<Shape>, motions: &[(&str, Motion)]) -> Scene {
 }
 
 fn cube(name: &str, c: DVec3, a: f64) -> Shape {
-    let mut vertices = Vec::new();
-    for i in 0..8 {
-        let s = |b: usize| if i >> b & 1 == 1 { a } else { -a };
-        vertices.push(c + DVec3::new(s(0), s(1), s(2)));
-    }
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    Shape {
-        name: name.into(),
-        vertices,
-        triangles: quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect(),
-        surface: Surface::Absorber,
-        medium: None,
-    }
+    geosens::mesh::cases::cube_shape(name, c, a, Surface::Absorber, None)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

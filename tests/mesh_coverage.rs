@@ -22,8 +22,9 @@
 //! (591/600 within 3σ, accepted from 592), which at 16 000 paths per run
 //! covers normally (0.955, 0.995): its weights' skew needs more paths than
 //! rendering's before the normal law holds. Hence 10 000 paths per run.
+use geosens::mesh::cases::{box_shape, lamp, up};
 use geosens::mesh::exact::{BoxScene, OccluderScene};
-use geosens::mesh::{Motion, Parameter, Scene, Sensor, Shape, Surface};
+use geosens::mesh::{Motion, Parameter, Scene, Shape, Surface};
 use geosens::{Estimate, Method, Quantity, RunConfig, run};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -92,19 +93,7 @@ fn check(c: &Count) -> Result<(), String> {
 
 /// The scenes: name, scene, closed-form E and sensitivities.
 fn scenes() -> Vec<(&'static str, Arc<Scene>, f64, [f64; 5])> {
-    let lamp = Shape {
-        name: "lamp".into(),
-        vertices: [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
-            .map(|(x, y)| DVec3::new(x, y, 2.0))
-            .to_vec(),
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        surface: Surface::Emitter { radiance: 1.0 },
-        medium: None,
-    };
-    let sensor = Sensor::Irradiance {
-        point: DVec3::ZERO,
-        normal: DVec3::Z,
-    };
+    let (lamp, sensor) = (lamp(), up());
     let build = |occ: Shape, motions: [Motion; 5]| {
         let parameters = NAMES
             .iter()
@@ -136,25 +125,7 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>, f64, [f64; 5])> {
         ));
     }
     let b = BoxScene::shipped(DVec3::new(0.2, -0.1, 1.0), 0.3);
-    let c = b.corners();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let occ = Shape {
-        name: "occ".into(),
-        vertices: c.to_vec(),
-        triangles: quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect(),
-        surface: Surface::Absorber,
-        medium: None,
-    };
+    let occ = box_shape("occ", b.corners(), Surface::Absorber, None);
     out.push((
         "box",
         build(occ, b.motions()),

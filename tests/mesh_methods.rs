@@ -1,66 +1,11 @@
 //! The 3D estimators against independent references: the closed-form
 //! irradiance under a square lamp, and finite differences with common
 //! random numbers at high sample counts for the sensitivities.
+use geosens::mesh::cases::{cube_shape as cube, lamp, square_shape as square, up};
 use geosens::mesh::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
 use geosens::{Method, Quantity, RunConfig, run};
 use glam::DVec3;
 use std::sync::Arc;
-
-/// A horizontal square of half-side `a` centred at `c`.
-fn square(name: &str, c: DVec3, a: f64, surface: Surface) -> Shape {
-    let v = [(-a, -a), (a, -a), (a, a), (-a, a)].map(|(x, y)| c + DVec3::new(x, y, 0.0));
-    Shape {
-        name: name.into(),
-        vertices: v.to_vec(),
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        surface,
-        medium: None,
-    }
-}
-
-/// An axis-aligned cube of half-side `a` centred at `c`, outward winding.
-fn cube(name: &str, c: DVec3, a: f64, surface: Surface, medium: Option<Medium>) -> Shape {
-    let mut vertices = Vec::new();
-    for i in 0..8 {
-        let s = |b: usize| if i >> b & 1 == 1 { a } else { -a };
-        vertices.push(c + DVec3::new(s(0), s(1), s(2)));
-    }
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let triangles = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    Shape {
-        name: name.into(),
-        vertices,
-        triangles,
-        surface,
-        medium,
-    }
-}
-
-fn lamp() -> Shape {
-    square(
-        "lamp",
-        DVec3::new(0.0, 0.0, 2.0),
-        0.5,
-        Surface::Emitter { radiance: 1.0 },
-    )
-}
-
-fn up() -> Sensor {
-    Sensor::Irradiance {
-        point: DVec3::ZERO,
-        normal: DVec3::Z,
-    }
-}
 
 fn params(shape: &str, motions: &[(&str, Motion)]) -> Vec<Parameter> {
     motions
@@ -543,7 +488,13 @@ fn a_mesh_inside_a_medium_matches_finite_differences() {
             Surface::Transparent,
             Some(fog),
         ),
-        cube("occ", DVec3::new(0.15, -0.1, 1.0), 0.2, Surface::Absorber, None),
+        cube(
+            "occ",
+            DVec3::new(0.15, -0.1, 1.0),
+            0.2,
+            Surface::Absorber,
+            None,
+        ),
     ];
     let scene = Arc::new(Scene::new(shapes, params("occ", &motions), up()).unwrap());
     assert_eq!(scene.sensor_medium(), Some(1));

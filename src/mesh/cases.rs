@@ -70,6 +70,100 @@ pub fn box_shape(
     }
 }
 
+/// An axis-aligned cube of half-side `half` centred at `centre` (a
+/// [`box_shape`]).
+pub fn cube_shape(
+    name: &str,
+    centre: DVec3,
+    half: f64,
+    surface: Surface,
+    medium: Option<Medium>,
+) -> Shape {
+    let corners = std::array::from_fn(|i| {
+        let s = |b: usize| if i >> b & 1 == 1 { half } else { -half };
+        centre + DVec3::new(s(0), s(1), s(2))
+    });
+    box_shape(name, corners, surface, medium)
+}
+
+/// A horizontal square of half-side `half` centred at `centre`, two
+/// triangles.
+pub fn square_shape(name: &str, centre: DVec3, half: f64, surface: Surface) -> Shape {
+    let v = [(-half, -half), (half, -half), (half, half), (-half, half)]
+        .map(|(x, y)| centre + DVec3::new(x, y, 0.0));
+    Shape {
+        name: name.into(),
+        vertices: v.to_vec(),
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        surface,
+        medium: None,
+    }
+}
+
+/// The unit icosphere subdivided `n` times: welded (a vertex shared by
+/// several triangles is the same `DVec3`, bit for bit), `20·4ⁿ` triangles,
+/// outward. Returns the vertices and the triangles as vertex indices.
+pub fn icosphere(n: u32) -> (Vec<DVec3>, Vec<[usize; 3]>) {
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<DVec3> = [
+        (-1.0, g, 0.0),
+        (1.0, g, 0.0),
+        (-1.0, -g, 0.0),
+        (1.0, -g, 0.0),
+        (0.0, -1.0, g),
+        (0.0, 1.0, g),
+        (0.0, -1.0, -g),
+        (0.0, 1.0, -g),
+        (g, 0.0, -1.0),
+        (g, 0.0, 1.0),
+        (-g, 0.0, -1.0),
+        (-g, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
+    .collect();
+    let mut f: Vec<[usize; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..n {
+        let mut mid: std::collections::HashMap<(usize, usize), usize> =
+            std::collections::HashMap::new();
+        let mut m = |a: usize, b: usize, v: &mut Vec<DVec3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                v.push((0.5 * (v[a] + v[b])).normalize());
+                v.len() - 1
+            })
+        };
+        f = f
+            .iter()
+            .flat_map(|&[a, b, c]| {
+                let (ab, bc, ca) = (m(a, b, &mut v), m(b, c, &mut v), m(c, a, &mut v));
+                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
+            })
+            .collect();
+    }
+    (v, f)
+}
+
 /// A horizontal black equilateral triangle: the occluder of the 3D figures
 /// and of `geosens compare`'s 3D table. Its three parameters, in the order
 /// of [`TriangleOccluder::PARAMETERS`]: translation along x, rotation about

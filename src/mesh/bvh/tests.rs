@@ -5,7 +5,6 @@
 use super::*;
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::collections::HashMap;
 
 type Tri = [DVec3; 3];
 
@@ -26,68 +25,7 @@ fn in_cube(rng: &mut Xoshiro256PlusPlus, h: f64) -> DVec3 {
     )
 }
 
-/// The unit icosphere subdivided `n` times: welded (a vertex shared by
-/// several triangles is the same `DVec3`, bit for bit), `20·4ⁿ` triangles.
-/// Returns the vertices and the triangles as vertex indices.
-fn icosphere(n: u32) -> (Vec<DVec3>, Vec<[usize; 3]>) {
-    let g = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        (-1.0, g, 0.0),
-        (1.0, g, 0.0),
-        (-1.0, -g, 0.0),
-        (1.0, -g, 0.0),
-        (0.0, -1.0, g),
-        (0.0, 1.0, g),
-        (0.0, -1.0, -g),
-        (0.0, 1.0, -g),
-        (g, 0.0, -1.0),
-        (g, 0.0, 1.0),
-        (-g, 0.0, -1.0),
-        (-g, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let mut f: Vec<[usize; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..n {
-        let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
-        let mut m = |a: usize, b: usize, v: &mut Vec<DVec3>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                v.push((0.5 * (v[a] + v[b])).normalize());
-                v.len() - 1
-            })
-        };
-        f = f
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let (ab, bc, ca) = (m(a, b, &mut v), m(b, c, &mut v), m(c, a, &mut v));
-                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
-            })
-            .collect();
-    }
-    (v, f)
-}
+use crate::mesh::cases::icosphere;
 
 /// The triangles of an indexed mesh, scaled by `s` and moved by `shift`.
 fn triangles(v: &[DVec3], f: &[[usize; 3]], s: f64, shift: DVec3) -> Vec<Tri> {
