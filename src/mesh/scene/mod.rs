@@ -13,6 +13,7 @@ use crate::error::Error;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 
+mod crossings;
 pub mod geometry;
 mod repr;
 #[cfg(test)]

@@ -10,7 +10,7 @@
 //! 3. the scene's size ([`MIN_SIZE`]..[`MAX_SIZE`]);
 //! 4. each mesh's triangles and edges: degenerate triangles, non-manifold
 //!    edges, orientation, closedness ([`topology`]);
-//! 5. meshes that cross or touch ([`check_crossings`]);
+//! 5. meshes that cross or touch (`crossings`);
 //! 6. closed meshes turned outward ([`orient`]);
 //! 7. parameters, sensor, optical thickness, media nesting.
 //!
@@ -19,7 +19,8 @@
 //! welding keeps the triangles' order, so triangle indices in later
 //! messages are the user's too. Vertex indices in later messages are those
 //! of the welded mesh.
-use super::geometry::{point_triangle_distance, signed_volume, triangles_within, winding_number};
+use super::crossings::{Aabb, check_crossings};
+use super::geometry::{point_triangle_distance, signed_volume, winding_number};
 use super::{
     MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE, Medium, Motion, Parameter, Scene,
     Sensor, Shape, Surface,
@@ -43,7 +44,7 @@ pub const TOUCH_DISTANCE: f64 = 1e-12;
 /// (flatland's rule).
 const SENSOR_DISTANCE: f64 = 1e-9;
 
-fn config<T>(msg: String) -> Result<T, Error> {
+pub(super) fn config<T>(msg: String) -> Result<T, Error> {
     Err(Error::Scene(msg))
 }
 
@@ -246,7 +247,7 @@ pub(super) fn weld(shape: &mut Shape) {
     shape.vertices = vertices;
 }
 
-fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
+pub(super) fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
     vertices
         .iter()
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
@@ -352,85 +353,6 @@ fn topology(s: &Shape) -> Result<bool, Error> {
         ));
     }
     Ok(true)
-}
-
-/// An axis-aligned box, widened by a tolerance where compared.
-#[derive(Clone, Copy)]
-struct Aabb {
-    lo: DVec3,
-    hi: DVec3,
-}
-
-impl Aabb {
-    fn of(points: &[DVec3]) -> Aabb {
-        let (lo, hi) = bounds(points);
-        Aabb { lo, hi }
-    }
-    fn meets(&self, o: &Aabb, tol: f64) -> bool {
-        (self.lo - tol).cmple(o.hi).all() && (o.lo - tol).cmple(self.hi).all()
-    }
-}
-
-/// Rejects triangles of different meshes that cross or come within
-/// [`TOUCH_DISTANCE`] × `size`. Broad phase: a sweep over x on the meshes'
-/// boxes finds the pairs of meshes whose boxes meet; for each pair, the
-/// triangles inside the other mesh's box are swept over x against each
-/// other, and the pairs whose boxes meet get the exact test
-/// ([`triangles_within`]). A large mesh beside small ones thus costs one
-/// pass over its triangles per neighbour.
-fn check_crossings(shapes: &[Shape], size: f64) -> Result<(), Error> {
-    let tol = TOUCH_DISTANCE * size;
-    let boxes: Vec<Aabb> = shapes.iter().map(|s| Aabb::of(&s.vertices)).collect();
-    let mut order: Vec<usize> = (0..shapes.len()).collect();
-    order.sort_by(|&i, &j| boxes[i].lo.x.total_cmp(&boxes[j].lo.x));
-    for (n, &k) in order.iter().enumerate() {
-        for &l in &order[n + 1..] {
-            if boxes[l].lo.x > boxes[k].hi.x + tol {
-                break;
-            }
-            if boxes[k].meets(&boxes[l], tol) {
-                check_pair(shapes, k.min(l), k.max(l), &boxes, tol)?;
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Rejects a triangle of shape `k` within `tol` of one of shape `l`.
-fn check_pair(shapes: &[Shape], k: usize, l: usize, boxes: &[Aabb], tol: f64) -> Result<(), Error> {
-    // Triangles of either mesh inside the other's box: (box, side, index).
-    let mut items: Vec<(Aabb, usize, u32)> = Vec::new();
-    for (side, (me, other)) in [(k, l), (l, k)].into_iter().enumerate() {
-        let s = &shapes[me];
-        for i in 0..s.triangles.len() {
-            let b = Aabb::of(&s.triangle(i));
-            if b.meets(&boxes[other], tol) {
-                items.push((b, side, i as u32));
-            }
-        }
-    }
-    items.sort_by(|a, b| a.0.lo.x.total_cmp(&b.0.lo.x));
-    let mut active: [Vec<(Aabb, u32)>; 2] = [Vec::new(), Vec::new()];
-    for &(b, side, i) in &items {
-        let other = 1 - side;
-        active[other].retain(|(o, _)| o.hi.x + tol >= b.lo.x);
-        for &(o, j) in &active[other] {
-            if !b.meets(&o, tol) {
-                continue;
-            }
-            let (ti, tj) = if side == 0 { (i, j) } else { (j, i) };
-            let (sk, sl) = (&shapes[k], &shapes[l]);
-            if triangles_within(sk.triangle(ti as usize), sl.triangle(tj as usize), tol) {
-                return config(format!(
-                    "shapes {:?} (triangle {ti}) and {:?} (triangle {tj}) touch or cross: \
-                     shapes must be disjoint",
-                    sk.name, sl.name
-                ));
-            }
-        }
-        active[side].push((b, i));
-    }
-    Ok(())
 }
 
 /// Turns each closed mesh outward (flips every triangle if its signed
