@@ -543,7 +543,13 @@ fn a_mesh_inside_a_medium_matches_finite_differences() {
             Surface::Transparent,
             Some(fog),
         ),
-        cube("occ", DVec3::new(0.15, -0.1, 1.0), 0.2, Surface::Absorber, None),
+        cube(
+            "occ",
+            DVec3::new(0.15, -0.1, 1.0),
+            0.2,
+            Surface::Absorber,
+            None,
+        ),
     ];
     let scene = Arc::new(Scene::new(shapes, params("occ", &motions), up()).unwrap());
     assert_eq!(scene.sensor_medium(), Some(1));
