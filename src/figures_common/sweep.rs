@@ -21,12 +21,15 @@ pub(crate) fn methods() -> impl Iterator<Item = Method> {
 /// factor the estimators' `∂E/∂π` is multiplied by to be that one.
 pub(crate) type Exact = (f64, f64, f64);
 
-/// The reference curves over `range` at `n` points: `π`, `E(π)`, `∂E/∂π(π)`.
+/// Reference curves: `π`, `E(π)`, `∂E/∂π(π)`.
+pub(crate) type Curves = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// The reference curves over `range` at `n` points.
 pub(crate) fn curve(
     range: (f64, f64),
     n: usize,
     exact: impl Fn(f64) -> Result<(f64, f64), Error>,
-) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>), Error> {
+) -> Result<Curves, Error> {
     let pi = grid(range, n);
     let mut e = Vec::with_capacity(pi.len());
     let mut de = Vec::with_capacity(pi.len());

@@ -12,7 +12,7 @@
 //! than [`MIN_SECONDS`] are repeated (same seed) and the fastest time kept.
 //! Bars with `σ = 0` cannot be drawn on the log axis and are left out (the
 //! JSON keeps them); pale bars have a relative variance of the variance
-//! (VOV) of at least [`Estimate::VOV_LIMIT`]: heavy tails, their `σ` and
+//! (VOV) of at least [`Estimate::VOV_LIMIT`](crate::stats::Estimate::VOV_LIMIT): heavy tails, their `σ` and
 //! so their `σ²·t` are not to be trusted.
 use super::{FigureOptions, load};
 use crate::error::Error;

@@ -12,7 +12,7 @@
 //!
 //! Every timing run uses one thread whatever `opts.threads`; runs shorter
 //! than [`MIN_SECONDS`] are repeated (same seed) and the fastest time kept.
-//! Pale bars have a VOV of at least [`Estimate::VOV_LIMIT`] (σ unreliable).
+//! Pale bars have a VOV of at least [`Estimate::VOV_LIMIT`](crate::stats::Estimate::VOV_LIMIT) (σ unreliable).
 use super::FigureOptions;
 use crate::error::Error;
 use crate::figures_common::efficiency::{self, Spec};
