@@ -8,13 +8,15 @@ use crate::flat::figures::{METHODS, REFERENCE_COLOR, color};
 use crate::method::{Method, Problem};
 use crate::plot::{Legend, Panel, Series, quiet_corner};
 use crate::rod::figures::convergence::path_counts;
+use serde::Serialize;
 use std::sync::Arc;
 
-/// One method's estimate of one quantity in one run.
-pub(crate) struct Run {
-    /// The method.
-    pub method: Method,
-    /// The parameter of the sensitivity judged.
+/// One estimate of one run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Record {
+    /// Method name.
+    pub method: &'static str,
+    /// The parameter of the panel.
     pub parameter: &'static str,
     /// `"E"` (intensity) or `"dE/dπ"`.
     pub quantity: &'static str,
@@ -46,7 +48,7 @@ pub(crate) fn measure<S>(
     e: f64,
     parameters: &[(&'static str, f64)],
     mut salt: u64,
-) -> Result<Vec<Run>, Error>
+) -> Result<Vec<Record>, Error>
 where
     Arc<S>: Problem,
 {
@@ -63,8 +65,8 @@ where
                     _ => (Quantity::sensitivity(parameter), "dE/dπ", de),
                 };
                 let est = get(&r, &q)?;
-                runs.push(Run {
-                    method,
+                runs.push(Record {
+                    method: method.name(),
                     parameter,
                     quantity,
                     paths: r.paths,

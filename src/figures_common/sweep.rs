@@ -9,6 +9,7 @@ use crate::estimator::Quantity;
 use crate::flat::figures::{DERIVATIVE_METHODS, color};
 use crate::method::{Method, Problem};
 use crate::plot::{Panel, Series};
+use serde::Serialize;
 use std::sync::Arc;
 
 /// The methods run at every value of `π`: intensity, then the derivative
@@ -41,25 +42,28 @@ pub(crate) fn curve(
     Ok((pi, e, de))
 }
 
-/// One method's estimate at one value of `π`.
-pub(crate) struct Run {
-    /// The value of `π`.
+/// One estimate at one value of `π`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Record {
+    /// The parameter.
+    pub parameter: &'static str,
+    /// Its value.
     pub pi: f64,
-    /// The method.
-    pub method: Method,
+    /// Method name.
+    pub method: &'static str,
     /// `"E"` or `"dE/dπ"`.
     pub quantity: &'static str,
     /// Paths sampled.
     pub paths: u64,
-    /// The estimate (times the factor for `∂E/∂π`).
+    /// The estimate.
     pub mean: f64,
-    /// Its standard error (likewise).
+    /// Its standard error.
     pub stderr: f64,
     /// Relative variance of the variance.
     pub vov: f64,
     /// The reference.
     pub exact: f64,
-    /// `(mean − exact) / stderr` (see [`z`]).
+    /// `(mean − exact) / stderr` (see [`z`](crate::mesh::figures::z)).
     pub z: Option<f64>,
 }
 
@@ -69,12 +73,12 @@ pub(crate) struct Run {
 pub(crate) fn measure<S>(
     opts: &FigureOptions,
     values: Vec<f64>,
-    parameter: &str,
+    parameter: &'static str,
     paths: u64,
     salt: &mut u64,
     bar: &indicatif::ProgressBar,
     at: impl Fn(f64) -> Result<(Arc<S>, Exact), Error>,
-) -> Result<Vec<Run>, Error>
+) -> Result<Vec<Record>, Error>
 where
     Arc<S>: Problem,
 {
@@ -90,9 +94,10 @@ where
             };
             let est = get(&r, &q)?;
             let (mean, stderr) = (est.mean * f, est.stderr * f);
-            runs.push(Run {
+            runs.push(Record {
+                parameter,
                 pi,
-                method,
+                method: method.name(),
                 quantity,
                 paths: r.paths,
                 mean,

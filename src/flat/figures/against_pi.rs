@@ -172,7 +172,7 @@ fn measure(
             scene: sweep.scene,
             parameter: sweep.parameter,
             pi: r.pi,
-            method: r.method.name(),
+            method: r.method,
             quantity: r.quantity,
             paths: r.paths,
             mean: r.mean,

@@ -81,7 +81,7 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let records = runs
         .into_iter()
         .map(|r| Record {
-            method: r.method.name(),
+            method: r.method,
             quantity: r.quantity,
             paths: r.paths,
             mean: r.mean,

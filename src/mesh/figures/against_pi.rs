@@ -65,30 +65,7 @@ pub const PATHS: u64 = 100_000;
 /// Base of the seed salts of this figure (distinct from the other figures').
 const SALT: u64 = 70_000_000;
 
-/// One estimate at one value of `π`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Record {
-    /// The parameter.
-    pub parameter: &'static str,
-    /// Its value.
-    pub pi: f64,
-    /// Method name.
-    pub method: &'static str,
-    /// `"E"` or `"dE/dπ"`.
-    pub quantity: &'static str,
-    /// Paths sampled.
-    pub paths: u64,
-    /// The estimate.
-    pub mean: f64,
-    /// Its standard error.
-    pub stderr: f64,
-    /// Relative variance of the variance.
-    pub vov: f64,
-    /// The closed form.
-    pub exact: f64,
-    /// `(mean − exact) / stderr` (see [`super::z`]).
-    pub z: Option<f64>,
-}
+pub use crate::figures_common::sweep::Record;
 
 /// The closed-form curve of one sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -147,25 +124,10 @@ fn measure(
     let k = sweep.parameter;
     let name = TriangleOccluder::PARAMETERS[k];
     let values = grid(sweep.range, VALUES);
-    let runs = sweep::measure(opts, values, name, PATHS, salt, bar, |pi| {
+    sweep::measure(opts, values, name, PATHS, salt, bar, |pi| {
         let scene = Arc::new(TriangleOccluder::NOMINAL.moved(k, pi).scene(&[k])?);
         Ok((scene, exact_at(sweep, pi)?))
-    })?;
-    Ok(runs
-        .into_iter()
-        .map(|r| Record {
-            parameter: name,
-            pi: r.pi,
-            method: r.method.name(),
-            quantity: r.quantity,
-            paths: r.paths,
-            mean: r.mean,
-            stderr: r.stderr,
-            vov: r.vov,
-            exact: r.exact,
-            z: r.z,
-        })
-        .collect())
+    })
 }
 
 /// Axis label of parameter `k`.

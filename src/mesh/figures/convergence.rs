@@ -12,7 +12,6 @@ use crate::error::Error;
 use crate::figures_common::convergence::{measure, panel};
 use crate::mesh::cases::TriangleOccluder;
 use crate::plot::Figure;
-use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -22,30 +21,7 @@ pub const PARAMETERS: [usize; 2] = [0, 1];
 /// Base of the seed salts of this figure (distinct from the other figures').
 const SALT: u64 = 71_000_000;
 
-/// One estimate of one run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Record {
-    /// Method name.
-    pub method: &'static str,
-    /// The parameter of the panel.
-    pub parameter: &'static str,
-    /// `"E"` (intensity) or `"dE/dπ"`.
-    pub quantity: &'static str,
-    /// Paths sampled, `N`.
-    pub paths: u64,
-    /// The estimate.
-    pub mean: f64,
-    /// Its standard error σ.
-    pub stderr: f64,
-    /// The closed form.
-    pub exact: f64,
-    /// `mean − exact`.
-    pub error: f64,
-    /// Relative variance of the variance.
-    pub vov: f64,
-    /// Sampling wall time of the run, seconds.
-    pub seconds: f64,
-}
+pub use crate::figures_common::convergence::Record;
 
 /// σ and |mean − exact| against N for every method on the triangle
 /// occluder's translation along x and rotation (one panel each), 10³ to
@@ -60,22 +36,7 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let scene = Arc::new(t.scene(&PARAMETERS)?);
     let (e, de) = t.exact()?;
     let parameters = PARAMETERS.map(|k| (TriangleOccluder::PARAMETERS[k], de[k]));
-    let runs = measure(opts, "mesh: convergence", &scene, e, &parameters, SALT)?;
-    let records: Vec<Record> = runs
-        .into_iter()
-        .map(|r| Record {
-            method: r.method.name(),
-            parameter: r.parameter,
-            quantity: r.quantity,
-            paths: r.paths,
-            mean: r.mean,
-            stderr: r.stderr,
-            exact: r.exact,
-            error: r.error,
-            vov: r.vov,
-            seconds: r.seconds,
-        })
-        .collect();
+    let records = measure(opts, "mesh: convergence", &scene, e, &parameters, SALT)?;
     let panels = PARAMETERS
         .iter()
         .map(|&k| {
