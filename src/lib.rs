@@ -50,6 +50,8 @@
 pub mod error;
 pub mod estimator;
 pub mod fd;
+#[cfg(feature = "figures")]
+mod figures_common;
 pub mod flat;
 pub mod mesh;
 pub mod method;

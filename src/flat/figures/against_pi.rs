@@ -7,13 +7,10 @@
 //! ranges make the shadow's ends sweep over the lamp's ends, where `E` has
 //! kinks and `∂E/∂π` jumps (occluder.toml: the occluder's translation and
 //! rotation); the absorbing slab's scale changes `E` smoothly.
-use super::{
-    DERIVATIVE_METHODS, FigureOptions, REFERENCE_COLOR, color, exact, load, only, parameter,
-    run_method, save,
-};
+use super::{FigureOptions, REFERENCE_COLOR, exact, load, only, parameter, save};
 use crate::error::Error;
-use crate::estimator::Quantity;
-use crate::flat::Method;
+use crate::figures_common::grid;
+use crate::figures_common::sweep::{self, QUANTITIES, columns, markers};
 use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -115,13 +112,6 @@ pub struct AgainstPi {
     pub curves: Vec<Curve>,
 }
 
-/// `n` evenly spaced values over `range`, ends included.
-fn grid((lo, hi): (f64, f64), n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect()
-}
-
 /// `(π, y)` split where `y` jumps (a step far larger than its neighbours'),
 /// so that a jump is drawn as a gap rather than a steep line.
 fn pieces(xy: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
@@ -149,14 +139,9 @@ fn pieces(xy: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
 fn curve(sweep: &Sweep) -> Result<Curve, Error> {
     let base = load(sweep.scene)?;
     let j = parameter(&base, sweep.parameter)?;
-    let pi = grid(sweep.range, CURVE_POINTS);
-    let mut e = Vec::with_capacity(pi.len());
-    let mut de = Vec::with_capacity(pi.len());
-    for &p in &pi {
-        let (v, d) = exact(&base.displaced(j, p)?, j)?;
-        e.push(v);
-        de.push(d);
-    }
+    let (pi, e, de) = sweep::curve(sweep.range, CURVE_POINTS, |p| {
+        exact(&base.displaced(j, p)?, j)
+    })?;
     Ok(Curve {
         scene: sweep.scene,
         parameter: sweep.parameter,
@@ -164,14 +149,6 @@ fn curve(sweep: &Sweep) -> Result<Curve, Error> {
         e,
         de,
     })
-}
-
-/// Legend label of `method` in this figure.
-fn label(method: Method) -> String {
-    match method {
-        Method::Intensity => "intensity (E)".into(),
-        m => format!("{} (∂E/∂π)", m.name()),
-    }
 }
 
 /// Runs every method at every value of `π` of `sweep`.
@@ -183,41 +160,27 @@ fn measure(
 ) -> Result<Vec<Record>, Error> {
     let base = load(sweep.scene)?;
     let j = parameter(&base, sweep.parameter)?;
-    let mut records = Vec::new();
-    for pi in grid(sweep.range, VALUES) {
+    let values = grid(sweep.range, VALUES);
+    let runs = sweep::measure(opts, values, sweep.parameter, PATHS, salt, bar, |pi| {
         let scene = Arc::new(only(&base.displaced(j, pi)?, j)?);
         let (e, de) = exact(&scene, 0)?;
-        for method in std::iter::once(Method::Intensity).chain(DERIVATIVE_METHODS) {
-            *salt += 1;
-            let r = run_method(opts, method, &scene, PATHS, *salt, opts.threads)?;
-            let (q, quantity, exact) = match method {
-                Method::Intensity => (Quantity::Intensity, "E", e),
-                _ => (Quantity::sensitivity(sweep.parameter), "dE/dπ", de),
-            };
-            let est = r
-                .get(&q)
-                .ok_or_else(|| Error::Output(format!("{} does not estimate {q}", method.name())))?;
-            let diff = est.mean - exact;
-            records.push(Record {
-                scene: sweep.scene,
-                parameter: sweep.parameter,
-                pi,
-                method: method.name(),
-                quantity,
-                paths: r.paths,
-                mean: est.mean,
-                stderr: est.stderr,
-                exact,
-                z: if diff == 0.0 {
-                    Some(0.0)
-                } else {
-                    (est.stderr > 0.0).then(|| diff / est.stderr)
-                },
-            });
-            bar.inc(1);
-        }
-    }
-    Ok(records)
+        Ok((scene, (e, de, 1.0)))
+    })?;
+    Ok(runs
+        .into_iter()
+        .map(|r| Record {
+            scene: sweep.scene,
+            parameter: sweep.parameter,
+            pi: r.pi,
+            method: r.method,
+            quantity: r.quantity,
+            paths: r.paths,
+            mean: r.mean,
+            stderr: r.stderr,
+            exact: r.exact,
+            z: r.z,
+        })
+        .collect())
 }
 
 /// The two panels of one sweep: `E` over its curve, `∂E/∂π` over its curve.
@@ -229,7 +192,7 @@ fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
         Legend::LowerRight,
         Legend::LowerLeft,
     ];
-    [("E", "E (irradiance)"), ("dE/dπ", "∂E/∂π")].map(|(quantity, y_label)| {
+    QUANTITIES.map(|(quantity, y_label)| {
         let ys = if quantity == "E" { &curve.e } else { &curve.de };
         let xy: Vec<(f64, f64)> = curve.pi.iter().copied().zip(ys.iter().copied()).collect();
         let mut series = Vec::new();
@@ -237,21 +200,13 @@ fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
             let label = if i == 0 { "analytic" } else { "" };
             series.push(Series::line(label, REFERENCE_COLOR, piece));
         }
-        let methods: Vec<Method> = if quantity == "E" {
-            vec![Method::Intensity]
-        } else {
-            DERIVATIVE_METHODS.to_vec()
-        };
-        for (k, &method) in methods.iter().enumerate() {
-            // Side by side, so that the error bars do not hide each other.
-            let offset = (k as f64 - 0.5 * (methods.len() - 1) as f64) * 0.1 * step;
-            let points = records
+        series.extend(markers(quantity, step, true, |method| {
+            records
                 .iter()
                 .filter(|r| r.method == method.name() && r.quantity == quantity)
-                .map(|r| (r.pi + offset, r.mean, r.stderr))
-                .collect();
-            series.push(Series::points(&label(method), color(method), points));
-        }
+                .map(|r| (r.pi, r.mean, r.stderr))
+                .collect()
+        }));
         let mut panel = Panel {
             title: format!(
                 "{}.toml: {} against {}",
@@ -273,24 +228,18 @@ fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
 /// `∂E/∂π` below), [`PATHS`] paths per run on `opts.threads`. Writes
 /// `flat_against_pi.{png,svg}` and `flat_against_pi.json`.
 pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let runs = SWEEPS.len() * VALUES * (1 + DERIVATIVE_METHODS.len());
+    let runs = SWEEPS.len() * VALUES * sweep::methods().count();
     let bar = opts.bar(runs as u64, "flat: against π");
     let mut salt = SALT;
-    let mut records = Vec::new();
-    let mut curves = Vec::new();
-    let mut top = Vec::new();
-    let mut bottom = Vec::new();
-    for sweep in &SWEEPS {
-        let c = curve(sweep)?;
-        let r = measure(opts, sweep, &mut salt, &bar)?;
-        let [e, de] = panels(sweep, &c, &r);
-        top.push(e);
-        bottom.push(de);
-        records.extend(r);
-        curves.push(c);
-    }
+    let columns = columns(
+        &SWEEPS,
+        curve,
+        |w| measure(opts, w, &mut salt, &bar),
+        panels,
+    )?;
     bar.finish();
-    top.extend(bottom);
+    let (records, curves, mut top) = (columns.records, columns.curves, columns.top);
+    top.extend(columns.bottom);
     let mut figure = Figure::new(top, SWEEPS.len());
     figure.panel_size = (640, 480);
     save(opts, "against_pi", &figure, &AgainstPi { records, curves })
@@ -299,6 +248,7 @@ pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::method::Method;
 
     #[test]
     fn jumps_break_the_curve() {

@@ -10,7 +10,8 @@
 use super::exact::Reference;
 use super::{Method, Scene, file};
 use crate::error::Error;
-use crate::runner::{RunConfig, RunResult, run};
+use crate::figures_common;
+use crate::runner::RunResult;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -56,19 +57,17 @@ pub const REFERENCE_COLOR: usize = 6;
 
 /// Every flatland figure, in the book's order; returns the files written.
 pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let figures: [FigureFn; 6] = [
-        scene::scene,
-        warp::warp,
-        against_pi::against_pi,
-        convergence::convergence,
-        efficiency::efficiency,
-        stability::stability,
-    ];
-    let mut written = Vec::new();
-    for figure in figures {
-        written.extend(figure(opts)?);
-    }
-    Ok(written)
+    figures_common::all(
+        opts,
+        &[
+            scene::scene,
+            warp::warp,
+            against_pi::against_pi,
+            convergence::convergence,
+            efficiency::efficiency,
+            stability::stability,
+        ],
+    )
 }
 
 /// The text of `scenes/<name>.toml`, compiled in; `None` for a name that is
@@ -128,8 +127,7 @@ pub fn run_method(
     salt: u64,
     threads: usize,
 ) -> Result<RunResult, Error> {
-    let cfg = RunConfig::new(opts.paths(paths), opts.seed.wrapping_add(salt))?.threads(threads);
-    run(method.estimator(Arc::clone(scene))?.as_ref(), &cfg)
+    figures_common::run_method(opts, method, scene, paths, salt, threads)
 }
 
 /// The file names (`flat_<name>.{png,svg}`) of a figure, saved with its
@@ -140,8 +138,5 @@ pub(crate) fn save<T: serde::Serialize>(
     figure: &crate::plot::Figure,
     numbers: &T,
 ) -> Result<Vec<PathBuf>, Error> {
-    let name = format!("flat_{name}");
-    let mut written = figure.save(&opts.out, &name)?;
-    written.push(opts.write_json(&name, numbers)?);
-    Ok(written)
+    figures_common::save(opts, "flat", name, figure, numbers)
 }

@@ -14,45 +14,23 @@
 //! Finite differences are drawn too; where they are biased (their step
 //! larger than `g` or `d`) the JSON's `z` says so. `tests/flat_failures.rs`
 //! pins the first two.
-use super::{DERIVATIVE_METHODS, FigureOptions, color, run_method, save};
+use super::{DERIVATIVE_METHODS, FigureOptions, color, save};
 use crate::error::Error;
-use crate::estimator::Quantity;
+use crate::figures_common::stability::{self, measure};
 use crate::flat::Scene;
 use crate::flat::exact::Reference;
 use crate::plot::{Figure, Legend, Panel, Series};
-use serde::Serialize;
 use std::path::PathBuf;
-use std::sync::Arc;
 
 /// Paths per run at effort 1.
 const PATHS: u64 = 100_000;
 /// Base of the seed salts of this figure.
 const SALT: u64 = 60_000_000;
 
-/// One run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Record {
-    /// Which failure (`"knots"`, `"sensor"`, `"thin"`).
-    pub case: &'static str,
-    /// The distance to the singular configuration (`g`, `d` or `t`).
-    pub distance: f64,
-    /// Method name.
-    pub method: &'static str,
-    /// Estimate of `∂E/∂π`.
-    pub mean: f64,
-    /// Its standard error.
-    pub stderr: f64,
-    /// Paths.
-    pub paths: u64,
-    /// `σ² N`.
-    pub variance: f64,
-    /// Relative variance of the variance.
-    pub vov: f64,
-    /// The analytic `∂E/∂π` where one exists.
-    pub exact: Option<f64>,
-    /// `|mean − exact| / σ` where an exact value exists.
-    pub z: Option<f64>,
-}
+/// One run (`case`: `"knots"`, `"sensor"` or `"thin"`; `distance`: `g`, `d`
+/// or `t`; `exact`: the analytic `∂E/∂π` where one exists; `z`:
+/// `|mean − exact| / σ`).
+pub use crate::figures_common::stability::Record;
 
 pub use crate::flat::cases::{knots, sensor_near_edge, thin_slab};
 
@@ -86,37 +64,24 @@ const CASES: [Case; 3] = [
 
 /// Runs the three cases and writes `flat_stability.{png,svg,json}`.
 pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let total: usize = CASES.iter().map(|c| c.2.len()).sum();
-    let bar = opts.bar((total * DERIVATIVE_METHODS.len()) as u64, "flat: stability");
-    let mut records = Vec::new();
-    let mut salt = SALT;
-    for (case, _, distances, build) in CASES {
-        for &distance in distances {
-            let scene = Arc::new(build(distance)?);
-            let exact = Reference::for_scene(&scene).ok().map(|r| r.derivative(0));
-            for method in DERIVATIVE_METHODS {
-                salt += 1;
-                let r = run_method(opts, method, &scene, PATHS, salt, opts.threads)?;
-                let e = r
-                    .get(&Quantity::sensitivity("p"))
-                    .ok_or_else(|| Error::Output("no sensitivity estimate".into()))?;
-                records.push(Record {
-                    case,
-                    distance,
-                    method: method.name(),
-                    mean: e.mean,
-                    stderr: e.stderr,
-                    paths: r.paths,
-                    variance: e.stderr * e.stderr * r.paths as f64,
-                    vov: e.vov,
-                    exact,
-                    z: exact.map(|x| e.z_score(x)),
-                });
-                bar.inc(1);
+    let builds: Vec<_> = CASES
+        .iter()
+        .map(|&(_, _, _, build)| {
+            move |distance: f64| -> Result<(Scene, Option<f64>), Error> {
+                let scene = build(distance)?;
+                let exact = Reference::for_scene(&scene).ok().map(|r| r.derivative(0));
+                Ok((scene, exact))
             }
-        }
-    }
-    bar.finish();
+        })
+        .collect();
+    let cases: Vec<stability::Case<'_, Scene>> = CASES
+        .iter()
+        .zip(&builds)
+        .map(|(&(case, _, distances, _), build)| (case, distances, build as _))
+        .collect();
+    let records = measure(opts, "flat: stability", &cases, PATHS, SALT, |e, x| {
+        Some(e.z_score(x))
+    })?;
     let panels = CASES
         .iter()
         .map(|&(case, axis, _, _)| {

@@ -16,13 +16,11 @@
 //! triangle's size `r₀(1 + π)`): the estimators differentiate a scale about
 //! the *current* size, `r ∂E/∂r`, so their estimates (and the closed form's)
 //! are divided by `1 + π`.
-use super::{
-    DERIVATIVE_METHODS, FigureOptions, REFERENCE_COLOR, color, get, label, run_method, save, z,
-};
+use super::{FigureOptions, REFERENCE_COLOR, color, label, save};
 use crate::error::Error;
-use crate::estimator::Quantity;
+use crate::figures_common::grid;
+use crate::figures_common::sweep::{self, QUANTITIES, columns, markers};
 use crate::mesh::cases::TriangleOccluder;
-use crate::method::Method;
 use crate::plot::{Figure, Panel, Series};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -67,30 +65,7 @@ pub const PATHS: u64 = 100_000;
 /// Base of the seed salts of this figure (distinct from the other figures').
 const SALT: u64 = 70_000_000;
 
-/// One estimate at one value of `π`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Record {
-    /// The parameter.
-    pub parameter: &'static str,
-    /// Its value.
-    pub pi: f64,
-    /// Method name.
-    pub method: &'static str,
-    /// `"E"` or `"dE/dπ"`.
-    pub quantity: &'static str,
-    /// Paths sampled.
-    pub paths: u64,
-    /// The estimate.
-    pub mean: f64,
-    /// Its standard error.
-    pub stderr: f64,
-    /// Relative variance of the variance.
-    pub vov: f64,
-    /// The closed form.
-    pub exact: f64,
-    /// `(mean − exact) / stderr` (see [`super::z`]).
-    pub z: Option<f64>,
-}
+pub use crate::figures_common::sweep::Record;
 
 /// The closed-form curve of one sweep.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -117,13 +92,6 @@ pub struct AgainstPi {
     pub curves: Vec<Curve>,
 }
 
-/// `n` evenly spaced values over `range`, ends included.
-fn grid((lo, hi): (f64, f64), n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect()
-}
-
 /// `E` and `∂E/∂π` of the plotted curve at `π` (see the module docs for the
 /// scale), and the factor applied to the estimators' derivative.
 fn exact_at(sweep: &Sweep, pi: f64) -> Result<(f64, f64, f64), Error> {
@@ -133,15 +101,11 @@ fn exact_at(sweep: &Sweep, pi: f64) -> Result<(f64, f64, f64), Error> {
     Ok((e, d[k] * factor, factor))
 }
 
+/// The sweep's closed-form curve.
 fn curve(sweep: &Sweep) -> Result<Curve, Error> {
-    let pi = grid(sweep.range, CURVE_POINTS);
-    let mut e = Vec::with_capacity(pi.len());
-    let mut de = Vec::with_capacity(pi.len());
-    for &p in &pi {
-        let (v, d, _) = exact_at(sweep, p)?;
-        e.push(v);
-        de.push(d);
-    }
+    let (pi, e, de) = sweep::curve(sweep.range, CURVE_POINTS, |p| {
+        exact_at(sweep, p).map(|(v, d, _)| (v, d))
+    })?;
     Ok(Curve {
         parameter: TriangleOccluder::PARAMETERS[sweep.parameter],
         pi,
@@ -150,6 +114,7 @@ fn curve(sweep: &Sweep) -> Result<Curve, Error> {
     })
 }
 
+/// Runs every method at every value of `π` of `sweep`.
 fn measure(
     opts: &FigureOptions,
     sweep: &Sweep,
@@ -158,35 +123,11 @@ fn measure(
 ) -> Result<Vec<Record>, Error> {
     let k = sweep.parameter;
     let name = TriangleOccluder::PARAMETERS[k];
-    let mut records = Vec::new();
-    for pi in grid(sweep.range, VALUES) {
+    let values = grid(sweep.range, VALUES);
+    sweep::measure(opts, values, name, PATHS, salt, bar, |pi| {
         let scene = Arc::new(TriangleOccluder::NOMINAL.moved(k, pi).scene(&[k])?);
-        let (e, de, factor) = exact_at(sweep, pi)?;
-        for method in std::iter::once(Method::Intensity).chain(DERIVATIVE_METHODS) {
-            *salt += 1;
-            let r = run_method(opts, method, &scene, PATHS, *salt, opts.threads)?;
-            let (q, quantity, exact, f) = match method {
-                Method::Intensity => (Quantity::Intensity, "E", e, 1.0),
-                _ => (Quantity::sensitivity(name), "dE/dπ", de, factor),
-            };
-            let est = get(&r, &q)?;
-            let (mean, stderr) = (est.mean * f, est.stderr * f);
-            records.push(Record {
-                parameter: name,
-                pi,
-                method: method.name(),
-                quantity,
-                paths: r.paths,
-                mean,
-                stderr,
-                vov: est.vov,
-                exact,
-                z: z(mean, stderr, exact),
-            });
-            bar.inc(1);
-        }
-    }
-    Ok(records)
+        Ok((scene, exact_at(sweep, pi)?))
+    })
 }
 
 /// Axis label of parameter `k`.
@@ -202,25 +143,17 @@ fn axis(k: usize) -> &'static str {
 /// legend has a panel of its own).
 fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
     let step = (sweep.range.1 - sweep.range.0) / (VALUES - 1) as f64;
-    [("E", "E (irradiance)"), ("dE/dπ", "∂E/∂π")].map(|(quantity, y_label)| {
+    QUANTITIES.map(|(quantity, y_label)| {
         let ys = if quantity == "E" { &curve.e } else { &curve.de };
         let xy = curve.pi.iter().copied().zip(ys.iter().copied()).collect();
         let mut series = vec![Series::line("", REFERENCE_COLOR, xy)];
-        let methods: Vec<Method> = if quantity == "E" {
-            vec![Method::Intensity]
-        } else {
-            DERIVATIVE_METHODS.to_vec()
-        };
-        for (i, &method) in methods.iter().enumerate() {
-            // Side by side, so that the error bars do not hide each other.
-            let offset = (i as f64 - 0.5 * (methods.len() - 1) as f64) * 0.1 * step;
-            let points = records
+        series.extend(markers(quantity, step, false, |method| {
+            records
                 .iter()
                 .filter(|r| r.method == method.name() && r.quantity == quantity)
-                .map(|r| (r.pi + offset, r.mean, r.stderr))
-                .collect();
-            series.push(Series::points("", color(method), points));
-        }
+                .map(|r| (r.pi, r.mean, r.stderr))
+                .collect()
+        }));
         Panel {
             title: format!(
                 "triangle occluder: {} against {}",
@@ -238,7 +171,7 @@ fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
 /// The legend panel: the closed form and every method.
 fn legend() -> Panel {
     let mut series = vec![Series::line("closed form", REFERENCE_COLOR, vec![])];
-    for method in std::iter::once(Method::Intensity).chain(DERIVATIVE_METHODS) {
+    for method in sweep::methods() {
         series.push(Series::points(&label(method), color(method), vec![]));
     }
     Panel {
@@ -260,25 +193,19 @@ fn legend() -> Panel {
 /// cargo run --release --example fig_mesh_against_pi -- [OUT_DIR] [EFFORT]
 /// ```
 pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let runs = SWEEPS.len() * VALUES * (1 + DERIVATIVE_METHODS.len());
+    let runs = SWEEPS.len() * VALUES * sweep::methods().count();
     let bar = opts.bar(runs as u64, "mesh: against π");
     let mut salt = SALT;
-    let mut records = Vec::new();
-    let mut curves = Vec::new();
-    let mut top = Vec::new();
-    let mut bottom = Vec::new();
-    for sweep in &SWEEPS {
-        let c = curve(sweep)?;
-        let r = measure(opts, sweep, &mut salt, &bar)?;
-        let [e, de] = panels(sweep, &c, &r);
-        top.push(e);
-        bottom.push(de);
-        records.extend(r);
-        curves.push(c);
-    }
+    let columns = columns(
+        &SWEEPS,
+        curve,
+        |w| measure(opts, w, &mut salt, &bar),
+        panels,
+    )?;
     bar.finish();
+    let (records, curves, mut top) = (columns.records, columns.curves, columns.top);
     top.push(legend());
-    top.extend(bottom);
+    top.extend(columns.bottom);
     let mut figure = Figure::new(top, SWEEPS.len() + 1);
     figure.panel_size = (560, 440);
     let o = TriangleOccluder::NOMINAL;
@@ -293,6 +220,7 @@ pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::method::Method;
 
     #[test]
     fn sweeps_stay_valid() {

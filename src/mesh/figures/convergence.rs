@@ -7,14 +7,11 @@
 //! a method gives both). The intensity estimator is judged on `E`, the
 //! others on `∂E/∂π`. A dashed `∝ 1/√N` line is the rate an unbiased
 //! finite-variance estimator shows.
-use super::{FigureOptions, METHODS, REFERENCE_COLOR, color, get, label, run_method, save};
+use super::{FigureOptions, save};
 use crate::error::Error;
-use crate::estimator::Quantity;
+use crate::figures_common::convergence::{measure, panel};
 use crate::mesh::cases::TriangleOccluder;
-use crate::method::Method;
-use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
-use crate::rod::figures::convergence::path_counts;
-use serde::Serialize;
+use crate::plot::Figure;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -24,82 +21,7 @@ pub const PARAMETERS: [usize; 2] = [0, 1];
 /// Base of the seed salts of this figure (distinct from the other figures').
 const SALT: u64 = 71_000_000;
 
-/// One estimate of one run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Record {
-    /// Method name.
-    pub method: &'static str,
-    /// The parameter of the panel.
-    pub parameter: &'static str,
-    /// `"E"` (intensity) or `"dE/dπ"`.
-    pub quantity: &'static str,
-    /// Paths sampled, `N`.
-    pub paths: u64,
-    /// The estimate.
-    pub mean: f64,
-    /// Its standard error σ.
-    pub stderr: f64,
-    /// The closed form.
-    pub exact: f64,
-    /// `mean − exact`.
-    pub error: f64,
-    /// Relative variance of the variance.
-    pub vov: f64,
-    /// Sampling wall time of the run, seconds.
-    pub seconds: f64,
-}
-
-/// The log–log panel of one parameter.
-fn panel(parameter: &str, records: &[Record]) -> Panel {
-    let mine: Vec<&Record> = records
-        .iter()
-        .filter(|r| r.parameter == parameter)
-        .collect();
-    let mut series = Vec::new();
-    for method in METHODS {
-        let rs: Vec<&&Record> = mine.iter().filter(|r| r.method == method.name()).collect();
-        let sigma = rs.iter().map(|r| (r.paths as f64, r.stderr)).collect();
-        let error = rs
-            .iter()
-            .map(|r| (r.paths as f64, r.error.abs(), 0.0))
-            .collect();
-        series.push(Series::line(&label(method), color(method), sigma));
-        series.push(Series::points("", color(method), error));
-    }
-    let ns = mine.iter().map(|r| r.paths as f64);
-    let (lo, hi) = ns.fold((f64::INFINITY, 0.0f64), |(lo, hi), n| {
-        (lo.min(n), hi.max(n))
-    });
-    let lowest = mine
-        .iter()
-        .filter(|r| r.paths as f64 == hi && r.stderr > 0.0)
-        .map(|r| r.stderr)
-        .fold(f64::INFINITY, f64::min);
-    if lowest.is_finite() {
-        let k = lowest / 3.0 * hi.sqrt();
-        series.push(Series::dashed(
-            "∝ 1/√N",
-            REFERENCE_COLOR,
-            vec![(lo, k / lo.sqrt()), (hi, k / hi.sqrt())],
-        ));
-    }
-    let mut panel = Panel {
-        title: format!("triangle occluder, π = {parameter}: error against paths"),
-        x_label: "N (paths)".into(),
-        y_label: "σ (lines), |mean − exact| (dots)".into(),
-        x_log: true,
-        y_log: true,
-        series,
-        ..Panel::default()
-    };
-    panel.legend = quiet_corner(
-        &panel,
-        &[Legend::LowerLeft, Legend::UpperRight],
-        (0.45, 0.4),
-    )
-    .0;
-    panel
-}
+pub use crate::figures_common::convergence::Record;
 
 /// σ and |mean − exact| against N for every method on the triangle
 /// occluder's translation along x and rotation (one panel each), 10³ to
@@ -113,41 +35,20 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let t = TriangleOccluder::NOMINAL;
     let scene = Arc::new(t.scene(&PARAMETERS)?);
     let (e, de) = t.exact()?;
-    let counts = path_counts(3, 6);
-    let bar = opts.bar((METHODS.len() * counts.len()) as u64, "mesh: convergence");
-    let mut records = Vec::new();
-    let mut salt = SALT;
-    for method in METHODS {
-        for &n in &counts {
-            salt += 1;
-            let r = run_method(opts, method, &scene, n, salt, opts.threads)?;
-            for k in PARAMETERS {
-                let name = TriangleOccluder::PARAMETERS[k];
-                let (q, quantity, exact) = match method {
-                    Method::Intensity => (Quantity::Intensity, "E", e),
-                    _ => (Quantity::sensitivity(name), "dE/dπ", de[k]),
-                };
-                let est = get(&r, &q)?;
-                records.push(Record {
-                    method: method.name(),
-                    parameter: name,
-                    quantity,
-                    paths: r.paths,
-                    mean: est.mean,
-                    stderr: est.stderr,
-                    exact,
-                    error: est.mean - exact,
-                    vov: est.vov,
-                    seconds: r.seconds,
-                });
-            }
-            bar.inc(1);
-        }
-    }
-    bar.finish();
+    let parameters = PARAMETERS.map(|k| (TriangleOccluder::PARAMETERS[k], de[k]));
+    let records = measure(opts, "mesh: convergence", &scene, e, &parameters, SALT)?;
     let panels = PARAMETERS
         .iter()
-        .map(|&k| panel(TriangleOccluder::PARAMETERS[k], &records))
+        .map(|&k| {
+            let parameter = TriangleOccluder::PARAMETERS[k];
+            let rows: Vec<_> = records
+                .iter()
+                .filter(|r| r.parameter == parameter)
+                .map(|r| (r.method, r.paths, r.stderr, r.error))
+                .collect();
+            let title = format!("triangle occluder, π = {parameter}: error against paths");
+            panel(title, &rows)
+        })
         .collect();
     let mut figure = Figure::new(panels, 2);
     figure.panel_size = (760, 560);

@@ -11,13 +11,13 @@
 //! struggle. Colours per method are flatland's ([`color`]).
 use super::Scene;
 use crate::error::Error;
-use crate::estimator::Quantity;
+use crate::figures_common;
 use crate::method::Method;
-use crate::runner::{RunConfig, RunResult, run};
-use crate::stats::Estimate;
+use crate::runner::RunResult;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+pub use crate::figures_common::{get, label, z};
 pub use crate::flat::figures::{DERIVATIVE_METHODS, METHODS, REFERENCE_COLOR, color};
 pub use crate::rod::figures::{FigureFn, FigureOptions};
 
@@ -28,17 +28,15 @@ pub mod stability;
 
 /// Every 3D figure, in the book's order; returns the files written.
 pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let figures: [FigureFn; 4] = [
-        against_pi::against_pi,
-        convergence::convergence,
-        efficiency::efficiency,
-        stability::stability,
-    ];
-    let mut written = Vec::new();
-    for figure in figures {
-        written.extend(figure(opts)?);
-    }
-    Ok(written)
+    figures_common::all(
+        opts,
+        &[
+            against_pi::against_pi,
+            convergence::convergence,
+            efficiency::efficiency,
+            stability::stability,
+        ],
+    )
 }
 
 /// Runs `method` on `scene` with `paths` (scaled by the effort) paths, seed
@@ -51,33 +49,7 @@ pub fn run_method(
     salt: u64,
     threads: usize,
 ) -> Result<RunResult, Error> {
-    let cfg = RunConfig::new(opts.paths(paths), opts.seed.wrapping_add(salt))?.threads(threads);
-    run(method.estimator(Arc::clone(scene))?.as_ref(), &cfg)
-}
-
-/// The estimate of `q` in `r`, or an error naming the method.
-pub fn get(r: &RunResult, q: &Quantity) -> Result<Estimate, Error> {
-    r.get(q)
-        .ok_or_else(|| Error::Output(format!("{} does not estimate {q}", r.method)))
-}
-
-/// `(mean − exact)/stderr`; 0 when the estimate is exact, `None` when
-/// `stderr = 0` but the estimate is not.
-pub fn z(mean: f64, stderr: f64, exact: f64) -> Option<f64> {
-    let diff = mean - exact;
-    if diff == 0.0 {
-        Some(0.0)
-    } else {
-        (stderr > 0.0).then(|| diff / stderr)
-    }
-}
-
-/// Legend label of `method`: what it is judged on.
-pub fn label(method: Method) -> String {
-    match method {
-        Method::Intensity => "intensity (E)".into(),
-        m => format!("{} (∂E/∂π)", m.name()),
-    }
+    figures_common::run_method(opts, method, scene, paths, salt, threads)
 }
 
 /// The file names (`mesh_<name>.{png,svg}`) of a figure, saved with its
@@ -88,8 +60,5 @@ pub(crate) fn save<T: serde::Serialize>(
     figure: &crate::plot::Figure,
     numbers: &T,
 ) -> Result<Vec<PathBuf>, Error> {
-    let name = format!("mesh_{name}");
-    let mut written = figure.save(&opts.out, &name)?;
-    written.push(opts.write_json(&name, numbers)?);
-    Ok(written)
+    figures_common::save(opts, "mesh", name, figure, numbers)
 }

@@ -23,14 +23,13 @@
 //!
 //! Finite differences are drawn too; their half step (2·10⁻³ of the scene's
 //! size) is larger than some of the distances, where they are biased.
-use super::{DERIVATIVE_METHODS, FigureOptions, REFERENCE_COLOR, color, get, run_method, save, z};
+use super::{DERIVATIVE_METHODS, FigureOptions, REFERENCE_COLOR, color, save, z};
 use crate::error::Error;
-use crate::estimator::Quantity;
+use crate::figures_common::stability::{self, measure};
+use crate::mesh::Scene;
 use crate::mesh::cases::{self, Case};
 use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
-use serde::Serialize;
 use std::path::PathBuf;
-use std::sync::Arc;
 
 /// Paths per run (times the effort).
 pub const PATHS: u64 = 100_000;
@@ -38,30 +37,10 @@ pub const PATHS: u64 = 100_000;
 /// Base of the seed salts of this figure.
 const SALT: u64 = 73_000_000;
 
-/// One run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Record {
-    /// Which case (`"near"`, `"grazing"`, `"thin"`, `"kink"`).
-    pub case: &'static str,
-    /// The distance to the singular configuration (`d`, `g`, `t` or `δ`).
-    pub distance: f64,
-    /// Method name.
-    pub method: &'static str,
-    /// Estimate of `∂E/∂p`.
-    pub mean: f64,
-    /// Its standard error.
-    pub stderr: f64,
-    /// Paths.
-    pub paths: u64,
-    /// `σ² N`.
-    pub variance: f64,
-    /// Relative variance of the variance.
-    pub vov: f64,
-    /// The closed-form `∂E/∂p` where one exists.
-    pub exact: Option<f64>,
-    /// `(mean − exact)/σ` where a closed form exists.
-    pub z: Option<f64>,
-}
+/// One run (`case`: `"near"`, `"grazing"`, `"thin"` or `"kink"`;
+/// `distance`: `d`, `g`, `t` or `δ`; `exact`: the closed-form `∂E/∂p` where
+/// one exists; `z`: `(mean − exact)/σ`).
+pub use crate::figures_common::stability::Record;
 
 /// One case: name, title, axis label, distances, scene builder.
 type CaseSpec = (
@@ -198,35 +177,13 @@ fn bottom(case: &str, axis: &str, records: &[Record]) -> Panel {
 /// cargo run --release --example fig_mesh_stability -- [OUT_DIR] [EFFORT]
 /// ```
 pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let total: usize = CASES.iter().map(|c| c.3.len()).sum();
-    let bar = opts.bar((total * DERIVATIVE_METHODS.len()) as u64, "mesh: stability");
-    let mut records = Vec::new();
-    let mut salt = SALT;
-    for (case, _, _, distances, build) in CASES {
-        for &distance in distances {
-            let (scene, exact) = build(distance)?;
-            let scene = Arc::new(scene);
-            for method in DERIVATIVE_METHODS {
-                salt += 1;
-                let r = run_method(opts, method, &scene, PATHS, salt, opts.threads)?;
-                let e = get(&r, &Quantity::sensitivity("p"))?;
-                records.push(Record {
-                    case,
-                    distance,
-                    method: method.name(),
-                    mean: e.mean,
-                    stderr: e.stderr,
-                    paths: r.paths,
-                    variance: e.stderr * e.stderr * r.paths as f64,
-                    vov: e.vov,
-                    exact,
-                    z: exact.and_then(|x| z(e.mean, e.stderr, x)),
-                });
-                bar.inc(1);
-            }
-        }
-    }
-    bar.finish();
+    let cases: Vec<stability::Case<'_, Scene>> = CASES
+        .iter()
+        .map(|(case, _, _, distances, build)| (*case, *distances, build as _))
+        .collect();
+    let records = measure(opts, "mesh: stability", &cases, PATHS, SALT, |e, x| {
+        z(e.mean, e.stderr, x)
+    })?;
     let mut panels: Vec<Panel> = CASES
         .iter()
         .map(|&(case, title, axis, _, _)| top(case, title, axis, &records))

@@ -117,19 +117,17 @@ pub type FigureFn = fn(&FigureOptions) -> Result<Vec<PathBuf>, Error>;
 
 /// Every figure of the rod, in the book's order; returns the files written.
 pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let figures: [FigureFn; 6] = [
-        finite_difference::finite_difference,
-        along::intensity_along_rod,
-        along::sensitivity_along_rod,
-        convergence::convergence,
-        efficiency::efficiency,
-        stability::stability,
-    ];
-    let mut written = Vec::new();
-    for figure in figures {
-        written.extend(figure(opts)?);
-    }
-    Ok(written)
+    crate::figures_common::all(
+        opts,
+        &[
+            finite_difference::finite_difference,
+            along::intensity_along_rod,
+            along::sensitivity_along_rod,
+            convergence::convergence,
+            efficiency::efficiency,
+            stability::stability,
+        ],
+    )
 }
 
 /// The paper's optically thin rod: κs = 0.07, κe = 0.1, length 2.

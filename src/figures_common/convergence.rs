@@ -1,0 +1,135 @@
+//! The convergence figures of flatland and 3D: every method ([`METHODS`])
+//! run at 10³ to 10⁶ paths on one scene, σ and |mean − exact| against the
+//! number of paths, log–log.
+use super::{FigureOptions, get, run_method};
+use crate::error::Error;
+use crate::estimator::Quantity;
+use crate::flat::figures::{METHODS, REFERENCE_COLOR, color};
+use crate::method::{Method, Problem};
+use crate::plot::{Legend, Panel, Series, quiet_corner};
+use crate::rod::figures::convergence::path_counts;
+use serde::Serialize;
+use std::sync::Arc;
+
+/// One estimate of one run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Record {
+    /// Method name.
+    pub method: &'static str,
+    /// The parameter of the panel.
+    pub parameter: &'static str,
+    /// `"E"` (intensity) or `"dE/dπ"`.
+    pub quantity: &'static str,
+    /// Paths sampled, `N`.
+    pub paths: u64,
+    /// The estimate.
+    pub mean: f64,
+    /// Its standard error σ.
+    pub stderr: f64,
+    /// The closed form.
+    pub exact: f64,
+    /// `mean − exact`.
+    pub error: f64,
+    /// Relative variance of the variance.
+    pub vov: f64,
+    /// Sampling wall time of the run, seconds.
+    pub seconds: f64,
+}
+
+/// Runs every method on `scene` at 10³ to 10⁶ paths in half decades (times
+/// the effort) on `opts.threads`, one salt a run from `salt` on; of every
+/// run, the intensity estimator is judged on `E` (`e`), the others on the
+/// sensitivity of every `(parameter, exact)` of `parameters`. `what` names
+/// the progress bar.
+pub(crate) fn measure<S>(
+    opts: &FigureOptions,
+    what: &str,
+    scene: &Arc<S>,
+    e: f64,
+    parameters: &[(&'static str, f64)],
+    mut salt: u64,
+) -> Result<Vec<Record>, Error>
+where
+    Arc<S>: Problem,
+{
+    let counts = path_counts(3, 6);
+    let bar = opts.bar((METHODS.len() * counts.len()) as u64, what);
+    let mut runs = Vec::new();
+    for method in METHODS {
+        for &n in &counts {
+            salt += 1;
+            let r = run_method(opts, method, scene, n, salt, opts.threads)?;
+            for &(parameter, de) in parameters {
+                let (q, quantity, exact) = match method {
+                    Method::Intensity => (Quantity::Intensity, "E", e),
+                    _ => (Quantity::sensitivity(parameter), "dE/dπ", de),
+                };
+                let est = get(&r, &q)?;
+                runs.push(Record {
+                    method: method.name(),
+                    parameter,
+                    quantity,
+                    paths: r.paths,
+                    mean: est.mean,
+                    stderr: est.stderr,
+                    exact,
+                    error: est.mean - exact,
+                    vov: est.vov,
+                    seconds: r.seconds,
+                });
+            }
+            bar.inc(1);
+        }
+    }
+    bar.finish();
+    Ok(runs)
+}
+
+/// The log–log panel titled `title`: σ as lines, |error| as dots, of the
+/// `(method, N, σ, error)` of `rows`, and a `∝ 1/√N` line a factor 3 under
+/// the lowest σ at the largest N.
+pub(crate) fn panel(title: String, rows: &[(&str, u64, f64, f64)]) -> Panel {
+    let mut series = Vec::new();
+    for method in METHODS {
+        let rs: Vec<_> = rows.iter().filter(|r| r.0 == method.name()).collect();
+        let sigma = rs.iter().map(|r| (r.1 as f64, r.2)).collect();
+        let error = rs.iter().map(|r| (r.1 as f64, r.3.abs(), 0.0)).collect();
+        series.push(Series::line(&super::label(method), color(method), sigma));
+        series.push(Series::points("", color(method), error));
+    }
+    // The reference slope, a factor 3 under the lowest σ at the largest N
+    // so that it hides no curve.
+    let ns = rows.iter().map(|r| r.1 as f64);
+    let (lo, hi) = ns.fold((f64::INFINITY, 0.0f64), |(lo, hi), n| {
+        (lo.min(n), hi.max(n))
+    });
+    let lowest = rows
+        .iter()
+        .filter(|r| r.1 as f64 == hi && r.2 > 0.0)
+        .map(|r| r.2)
+        .fold(f64::INFINITY, f64::min);
+    if lowest.is_finite() {
+        let k = lowest / 3.0 * hi.sqrt();
+        series.push(Series::dashed(
+            "∝ 1/√N",
+            REFERENCE_COLOR,
+            vec![(lo, k / lo.sqrt()), (hi, k / hi.sqrt())],
+        ));
+    }
+    let mut panel = Panel {
+        title,
+        x_label: "N (paths)".into(),
+        y_label: "σ (lines), |mean − exact| (dots)".into(),
+        x_log: true,
+        y_log: true,
+        series,
+        ..Panel::default()
+    };
+    panel.legend = quiet_corner(
+        &panel,
+        &[Legend::LowerLeft, Legend::UpperRight],
+        (0.45, 0.4),
+    )
+    .0;
+    panel
+}
