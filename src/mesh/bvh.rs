@@ -1,8 +1,9 @@
 //! Ray casting against triangles: the `f64` ray–triangle test
 //! [`intersect`], a bounding volume hierarchy [`TriangleBvh`] and the
 //! brute-force [`LinearTriangles`], which answer every query alike, bit for
-//! bit. The design is flatland's [`SegmentBvh`](crate::flat::bvh::SegmentBvh)
-//! in one more dimension.
+//! bit. The tree, its unit frame and its traversal are shared with
+//! flatland's [`SegmentBvh`](crate::flat::bvh::SegmentBvh) in
+//! [`bvh_frame`](crate::bvh_frame); this module adds the triangle.
 //!
 //! # The triangle test
 //!

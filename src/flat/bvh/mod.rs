@@ -4,8 +4,9 @@
 //! --bench raycast` found the scan ahead at 16 segments and 1.8 times
 //! behind at 32; at 10⁴ segments the BVH is about 100 times faster.
 //!
-//! The hierarchy is obvhs's binary BVH, built by PLOC on a degenerate 3D
-//! embedding: segment `i` becomes the box `[min x, min y, −1] … [max x,
+//! The hierarchy, shared with the mesh's triangles in
+//! [`bvh_frame`](crate::bvh_frame), is obvhs's binary BVH, built by PLOC on
+//! a degenerate 3D embedding: segment `i` becomes the box `[min x, min y, −1] … [max x,
 //! max y, +1]` and rays lie in the plane `z = 0`. With the constant depth,
 //! the builder's surface-area cost `dx dy + 2 (dx + dy)` is mostly the box
 //! perimeter, the right cost in the plane (a random line meets a convex set
