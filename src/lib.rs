@@ -47,6 +47,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod bvh_frame;
 pub mod error;
 pub mod estimator;
 pub mod fd;

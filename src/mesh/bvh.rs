@@ -1,8 +1,9 @@
 //! Ray casting against triangles: the `f64` ray–triangle test
 //! [`intersect`], a bounding volume hierarchy [`TriangleBvh`] and the
 //! brute-force [`LinearTriangles`], which answer every query alike, bit for
-//! bit. The design is flatland's [`SegmentBvh`](crate::flat::bvh::SegmentBvh)
-//! in one more dimension.
+//! bit. The tree, its unit frame and its traversal are shared with
+//! flatland's [`SegmentBvh`](crate::flat::bvh::SegmentBvh) in
+//! [`bvh_frame`](crate::bvh_frame); this module adds the triangle.
 //!
 //! # The triangle test
 //!
@@ -33,21 +34,11 @@
 //!
 //! ## Conservative culling
 //!
-//! The boxes live in a *unit frame*: the scene translated and scaled by a
-//! power of two (exact) so that it fits in `[−1, 1]³`; huge or tiny
-//! coordinates (10³⁰, 10⁻³⁰) are then no concern of `f32`. Each box is
-//! padded by [`PAD`] = 2⁻¹⁶ of the scene half-size, and so is each `f32`
-//! distance bound: far more than the `f32` rounding of the ray (origin,
-//! direction, slab arithmetic: below 10⁻⁶ inside the frame). The query
-//! direction is scaled by a power of two to a largest component in
-//! `[1, 2)`, so ray parameters are frame distances within a factor √3, and
-//! obvhs's clamp of inverse directions at 1/ε (ε = 2⁻²³) only shortens
-//! slabs to at least `PAD/ε` ≈ 128, beyond any parameter inside the frame
-//! (≤ 2√3). A ray from outside the padded scene box first moves, in
-//! `f64`, to where it enters it, so the `f32` ray starts in the frame
-//! whatever the origin. Rays the frame cannot hold (origins farther than
-//! 2³⁰ scene sizes, non-finite input, directions whose size over- or
-//! underflows) fall back to a scan of all triangles, with the same answer.
+//! The boxes live in the *unit frame* of [`bvh_frame`](crate::bvh_frame),
+//! padded by [`PAD`]; the argument that the `f32` culling never loses a hit
+//! (coordinates of 10³⁰ or 10⁻³⁰ included), and the fallback to a scan of
+//! all triangles for rays the frame cannot hold, are stated there once for
+//! both casters.
 //!
 //! ## Small scenes
 //!
@@ -61,9 +52,7 @@
 //!
 //! # Cost
 //!
-//! No heap allocation per query: the traversal stack is a fixed array on
-//! the call stack sized from the tree depth measured at construction (64 or
-//! 256 entries; deeper trees, never seen, take a heap stack per query).
+//! No heap allocation per query (see [`bvh_frame`](crate::bvh_frame#cost)).
 //! `cargo bench --bench mesh_raycast` (one core, an icosphere of 81 920
 //! triangles around a torus of 24 576, 106 496 in all, rays from random
 //! points in the box `[−1.1, 1.1]³` in random directions) measured
@@ -80,15 +69,13 @@
 //! `build_bvh2_from_tris`: the `f64` watertight test, the padding and the
 //! exact ties cost less than a factor 1.5. The tree is 22 levels deep.
 use std::fmt;
-use std::time::Duration;
 
 use glam::DVec3;
-use obvhs::BvhBuildParams;
-use obvhs::aabb::Aabb;
-use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::builder::build_bvh2;
-use obvhs::faststack::{FastStack, StackStack};
-use obvhs::ray::{Ray, RayHit};
+
+#[cfg(test)]
+use crate::bvh_frame::NONE;
+pub use crate::bvh_frame::PAD;
+use crate::bvh_frame::{Primitive, Tree, scan_any, scan_closest};
 
 /// Smallest ray distance counted as a hit, relative to the longest edge of
 /// the triangle hit (and to the size of the ray direction): as flatland's
@@ -97,21 +84,9 @@ use obvhs::ray::{Ray, RayHit};
 /// threshold scales with the scene.
 pub const T_MIN: f64 = 1e-12;
 
-/// Pad of every box and every distance bound, in units of the scene's
-/// half-size (the unit frame): 2⁻¹⁶ ≈ 1.5·10⁻⁵.
-pub const PAD: f64 = 1.0 / 65536.0;
-
 /// Below this many (finite) triangles, [`TriangleBvh`] scans them instead
 /// of building a tree (see the [module docs](self#small-scenes)).
 pub const LINEAR_BELOW: usize = 4;
-
-/// Origins farther than this from the scene centre (in the unit frame) are
-/// traced by a linear scan: beyond it, the `f64` clipping error would
-/// approach [`PAD`].
-const FAR: f64 = (1u64 << 30) as f64;
-
-/// No triangle (the `skip` of a query that skips none).
-const NONE: u32 = u32::MAX;
 
 /// Distance `t` along the ray `origin + t dir` (`dir` need not be unit) to
 /// the triangle, if the ray crosses it (edges and vertices included)
@@ -223,31 +198,30 @@ fn finite_prims(triangles: Vec<[DVec3; 3]>) -> Vec<Prim> {
         .collect()
 }
 
-/// The closest of `prims` other than `skip` hit with `t < t_max`, ties to
-/// the lowest index.
-#[inline]
-fn scan_closest(prims: &[Prim], ray: &Shear, t_max: f64, skip: u32) -> Option<(f64, u32)> {
-    let mut best = (t_max, NONE);
-    for p in prims {
-        if p.id == skip {
-            continue;
-        }
-        if let Some(t) = ray.hit(&p.tri)
-            && (t < best.0 || (t == best.0 && p.id < best.1))
-            && t < t_max
-        {
-            best = (t, p.id);
-        }
-    }
-    (best.1 != NONE).then_some(best)
-}
+impl Primitive for Prim {
+    type Vector = DVec3;
+    type Ray = Shear;
 
-/// Whether any of `prims` other than `skip` is hit with `t < t_max`.
-#[inline]
-fn scan_any(prims: &[Prim], ray: &Shear, t_max: f64, skip: u32) -> bool {
-    prims
-        .iter()
-        .any(|p| p.id != skip && ray.hit(&p.tri).is_some_and(|t| t < t_max))
+    #[inline(always)]
+    fn ray(origin: DVec3, dir: DVec3) -> Shear {
+        Shear::new(origin, dir)
+    }
+
+    #[inline(always)]
+    fn hit(&self, ray: &Shear) -> Option<f64> {
+        ray.hit(&self.tri)
+    }
+
+    #[inline]
+    fn bounds(&self) -> (DVec3, DVec3) {
+        let [a, b, c] = self.tri;
+        (a.min(b).min(c), a.max(b).max(c))
+    }
+
+    #[inline(always)]
+    fn id(&self) -> u32 {
+        self.id
+    }
 }
 
 /// Ray casting by testing every triangle: the reference [`TriangleBvh`] is
@@ -301,118 +275,12 @@ impl LinearTriangles {
     }
 }
 
-/// The map from scene coordinates to the unit frame, `p ↦ p s − c s`, with
-/// `s` a power of two (so `p s` is exact).
-#[derive(Debug, Clone, Copy)]
-struct Frame {
-    /// The centre times the scale.
-    offset: DVec3,
-    /// The scale, a power of two.
-    scale: f64,
-}
-
-impl Frame {
-    /// The frame in which `prims` fill about `[−1, 1]³`.
-    fn new(prims: &[Prim]) -> Frame {
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for p in prims {
-            for v in p.tri {
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-        }
-        if !(lo.is_finite() && hi.is_finite()) {
-            return Frame {
-                offset: DVec3::ZERO,
-                scale: 1.0,
-            };
-        }
-        // Halves first: `hi − lo` may overflow.
-        let centre = 0.5 * lo + 0.5 * hi;
-        let half = (0.5 * hi - 0.5 * lo).max_element();
-        // 2^−e with 2^(e−1) < half ≤ 2^e, so the scene fits in [−1, 1]³; the
-        // clamp keeps the scale a normal number (larger or smaller scenes
-        // are still bounded conservatively, in a larger box or a speck).
-        let e = if half > 0.0 {
-            (half.log2().ceil() as i64).clamp(-1000, 1022)
-        } else {
-            0
-        };
-        let scale = f64::from_bits(((1023 - e) as u64) << 52);
-        Frame {
-            offset: centre * scale,
-            scale,
-        }
-    }
-
-    #[inline]
-    fn map(&self, p: DVec3) -> DVec3 {
-        p * self.scale - self.offset
-    }
-}
-
-/// Where the `f32` ray of a query starts and how distances map onto it.
-struct Clip {
-    /// The `f32` ray: origin `o + s0 w`, direction `w`, where `o` is the
-    /// query origin in the frame and `w = d / m` the query direction in the
-    /// frame scaled by a power of two to a largest component in `[1, 2)`.
-    ray: Ray,
-    /// The power of two: query distance `t` is ray parameter `t m − s0`.
-    m: f64,
-    /// Ray parameter of the `f32` ray's origin from the query origin.
-    s0: f64,
-}
-
-impl Clip {
-    /// The `f32` bound for a hit at query distance `t`: boxes entered
-    /// beyond it cannot hold a hit closer than `t`.
-    #[inline]
-    fn bound(&self, t: f64) -> f32 {
-        ((t * self.m - self.s0) + PAD) as f32
-    }
-}
-
-/// What a query needs: nothing (no hit possible), a linear scan (no tree,
-/// or the frame cannot hold the ray), or a traversal.
-enum Plan {
-    Miss,
-    Linear,
-    Trace(Clip),
-}
-
-/// Runs `$body` with `$stack` bound to a traversal stack deep enough for a
-/// tree of `$depth` levels: a fixed array when it fits, else a heap one.
-macro_rules! with_stack {
-    ($depth:expr, $stack:ident, $body:expr) => {
-        // A push beyond a StackStack's last slot overwrites it silently: the
-        // stack holds at most depth − 1 entries, and N − 1 fit.
-        if $depth < 64 {
-            let $stack = &mut StackStack::<u32, 64>::default();
-            $body
-        } else if $depth < 256 {
-            let $stack = &mut StackStack::<u32, 256>::default();
-            $body
-        } else {
-            let $stack = &mut Vec::<u32>::with_capacity($depth);
-            $body
-        }
-    };
-}
-
 /// A BVH ray caster over a fixed list of triangles; see the [module
 /// docs](self). Answers exactly as [`LinearTriangles`] over the same list.
 #[derive(Clone)]
 pub struct TriangleBvh {
-    /// Empty below [`LINEAR_BELOW`] triangles.
-    bvh: Bvh2,
-    /// The finite triangles in BVH leaf order (list order without a tree).
-    prims: Vec<Prim>,
-    frame: Frame,
-    /// The padded scene box in the frame; rays are clipped to it.
-    lo: DVec3,
-    hi: DVec3,
-    /// Nodes on the longest root-to-leaf path (sizes the traversal stack).
-    depth: usize,
+    /// The finite triangles (no tree below [`LINEAR_BELOW`]).
+    tree: Tree<Prim>,
     /// Length of the list given.
     count: usize,
 }
@@ -421,9 +289,9 @@ impl fmt::Debug for TriangleBvh {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("TriangleBvh")
             .field("triangles", &self.count)
-            .field("finite", &self.prims.len())
-            .field("nodes", &self.bvh.nodes.len())
-            .field("depth", &self.depth)
+            .field("finite", &self.tree.prims().len())
+            .field("nodes", &self.tree.nodes())
+            .field("depth", &self.tree.depth())
             .finish()
     }
 }
@@ -442,42 +310,8 @@ impl TriangleBvh {
     #[doc(hidden)]
     pub fn with_linear_below(triangles: Vec<[DVec3; 3]>, linear_below: usize) -> TriangleBvh {
         let count = triangles.len();
-        let finite = finite_prims(triangles);
-        let frame = Frame::new(&finite);
-        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        let boxes: Vec<Aabb> = finite
-            .iter()
-            .map(|p| {
-                let [a, b, c] = p.tri.map(|v| frame.map(v));
-                let (min, max) = (a.min(b).min(c) - PAD, a.max(b).max(c) + PAD);
-                lo = lo.min(min);
-                hi = hi.max(max);
-                Aabb::new(min.as_vec3a(), max.as_vec3a())
-            })
-            .collect();
-        let (bvh, prims) = if boxes.is_empty() || boxes.len() < linear_below {
-            (Bvh2::default(), finite)
-        } else {
-            let bvh = build_bvh2(
-                &boxes,
-                BvhBuildParams::medium_build(),
-                &mut Duration::default(),
-            );
-            let prims = bvh
-                .primitive_indices
-                .iter()
-                .map(|&k| finite[k as usize])
-                .collect();
-            (bvh, prims)
-        };
-        let depth = tree_depth(&bvh);
         TriangleBvh {
-            bvh,
-            prims,
-            frame,
-            lo: lo - PAD,
-            hi: hi + PAD,
-            depth,
+            tree: Tree::new(finite_prims(triangles), linear_below),
             count,
         }
     }
@@ -492,118 +326,6 @@ impl TriangleBvh {
         self.count == 0
     }
 
-    /// How to answer a query.
-    #[inline]
-    fn plan(&self, origin: DVec3, dir: DVec3, t_max: f64) -> Plan {
-        if t_max.is_nan() || t_max <= 0.0 || self.prims.is_empty() {
-            return Plan::Miss;
-        }
-        if self.bvh.nodes.is_empty() {
-            return Plan::Linear;
-        }
-        let o = self.frame.map(origin);
-        let d = dir * self.frame.scale;
-        let a = d.abs().max_element();
-        if !(o.is_finite() && a > 0.0 && a.is_finite()) || o.abs().max_element() > FAR {
-            return Plan::Linear;
-        }
-        // m = 2^⌊log₂ a⌋ and w = d / m, both exact, without a division.
-        let e = a.to_bits() >> 52; // a > 0: the biased exponent
-        if !a.is_normal() || e >= 2045 {
-            return Plan::Linear;
-        }
-        let m = f64::from_bits(e << 52);
-        let w = d * f64::from_bits((2046 - e) << 52);
-        // An origin outside the padded scene box moves to where the ray
-        // enters it, at parameter s0.
-        let mut s0 = 0.0_f64;
-        if o.cmplt(self.lo).any() || o.cmpgt(self.hi).any() {
-            let mut s1 = f64::INFINITY;
-            for i in 0..3 {
-                if w[i] == 0.0 {
-                    if o[i] < self.lo[i] || o[i] > self.hi[i] {
-                        return Plan::Miss;
-                    }
-                } else {
-                    let inv = 1.0 / w[i];
-                    let (ta, tb) = ((self.lo[i] - o[i]) * inv, (self.hi[i] - o[i]) * inv);
-                    s0 = s0.max(ta.min(tb));
-                    s1 = s1.min(ta.max(tb));
-                }
-            }
-            if s0 > s1 || s0 > t_max * m + PAD {
-                return Plan::Miss;
-            }
-        }
-        let p = o + s0 * w;
-        let mut clip = Clip {
-            ray: Ray::new(p.as_vec3a(), w.as_vec3a(), 0.0, f32::INFINITY),
-            m,
-            s0,
-        };
-        clip.ray.tmax = clip.bound(t_max);
-        Plan::Trace(clip)
-    }
-
-    /// The closest hit by traversal, with `stack` as the traversal stack.
-    #[inline(always)]
-    fn closest_with<S: FastStack<u32>>(
-        &self,
-        stack: &mut S,
-        clip: &Clip,
-        ray: &Shear,
-        t_max: f64,
-        skip: u32,
-    ) -> Option<(f64, u32)> {
-        let mut best = (t_max, NONE);
-        let mut leaf = |node: &obvhs::bvh2::node::Bvh2Node, r: &mut Ray, _: &mut RayHit| {
-            let first = node.first_index as usize;
-            for p in &self.prims[first..first + node.prim_count as usize] {
-                if p.id == skip {
-                    continue;
-                }
-                if let Some(t) = ray.hit(&p.tri)
-                    && t < t_max
-                    && (t < best.0 || (t == best.0 && p.id < best.1))
-                {
-                    best = (t, p.id);
-                    // Padded: a later equal-t, lower-index hit is still reached.
-                    r.tmax = r.tmax.min(clip.bound(t));
-                }
-            }
-            true
-        };
-        self.bvh
-            .ray_traverse_dynamic(stack, clip.ray, &mut RayHit::none(), &mut leaf);
-        (best.1 != NONE).then_some(best)
-    }
-
-    /// Whether any triangle is hit, by traversal with `stack`.
-    #[inline(always)]
-    fn any_with<S: FastStack<u32>>(
-        &self,
-        stack: &mut S,
-        clip: &Clip,
-        ray: &Shear,
-        t_max: f64,
-        skip: u32,
-    ) -> bool {
-        let mut found = false;
-        let mut leaf = |node: &obvhs::bvh2::node::Bvh2Node, _: &mut Ray, _: &mut RayHit| {
-            let first = node.first_index as usize;
-            found = scan_any(
-                &self.prims[first..first + node.prim_count as usize],
-                ray,
-                t_max,
-                skip,
-            );
-            !found // false halts the traversal
-        };
-        self.bvh
-            .ray_traverse_dynamic(stack, clip.ray, &mut RayHit::none(), &mut leaf);
-        found
-    }
-
     /// The closest triangle other than `skip` (`u32::MAX`: none) crossed by
     /// `origin + t dir` with `t < t_max`, as `(t, index)`; exactly
     /// [`LinearTriangles::closest_hit`]'s answer (ties to the lowest index).
@@ -614,58 +336,15 @@ impl TriangleBvh {
         t_max: f64,
         skip: u32,
     ) -> Option<(f64, u32)> {
-        match self.plan(origin, dir, t_max) {
-            Plan::Miss => None,
-            Plan::Linear => scan_closest(&self.prims, &Shear::new(origin, dir), t_max, skip),
-            Plan::Trace(clip) => {
-                let ray = Shear::new(origin, dir);
-                with_stack!(
-                    self.depth,
-                    stack,
-                    self.closest_with(stack, &clip, &ray, t_max, skip)
-                )
-            }
-        }
+        self.tree.closest_hit(origin, dir, t_max, skip)
     }
 
     /// Whether any triangle other than `skip` (`u32::MAX`: none) is crossed
     /// by `origin + t dir` with `t < t_max`; exactly
     /// [`LinearTriangles::any_hit`]'s answer.
     pub fn any_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, skip: u32) -> bool {
-        match self.plan(origin, dir, t_max) {
-            Plan::Miss => false,
-            Plan::Linear => scan_any(&self.prims, &Shear::new(origin, dir), t_max, skip),
-            Plan::Trace(clip) => {
-                let ray = Shear::new(origin, dir);
-                with_stack!(
-                    self.depth,
-                    stack,
-                    self.any_with(stack, &clip, &ray, t_max, skip)
-                )
-            }
-        }
+        self.tree.any_hit(origin, dir, t_max, skip)
     }
-}
-
-/// Nodes on the longest root-to-leaf path of `bvh` (0 if empty), without
-/// recursion.
-fn tree_depth(bvh: &Bvh2) -> usize {
-    if bvh.nodes.is_empty() {
-        return 0;
-    }
-    let mut deepest = 0;
-    let mut todo = vec![(0usize, 1usize)];
-    while let Some((i, d)) = todo.pop() {
-        let node = &bvh.nodes[i];
-        if node.is_leaf() {
-            deepest = deepest.max(d);
-        } else {
-            let c = node.first_index as usize;
-            todo.push((c, d + 1));
-            todo.push((c + 1, d + 1));
-        }
-    }
-    deepest
 }
 
 #[cfg(test)]
