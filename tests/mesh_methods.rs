@@ -529,7 +529,7 @@ fn a_moving_lamp_and_scaled_scenes_match_the_closed_forms() {
         .iter()
         .map(|&(x, y)| centre + tilt * DVec3::new(x, y, 0.0))
         .collect();
-    let lamp = Shape {
+    let tilted = Shape {
         name: "lamp".into(),
         vertices: poly.clone(),
         triangles: vec![[0, 1, 2], [0, 2, 3]],
@@ -553,7 +553,7 @@ fn a_moving_lamp_and_scaled_scenes_match_the_closed_forms() {
             },
         ),
     ];
-    let scene = Arc::new(Scene::new(vec![lamp], params("lamp", &motions), up()).unwrap());
+    let scene = Arc::new(Scene::new(vec![tilted], params("lamp", &motions), up()).unwrap());
     let (e, g) = polygon_irradiance_with_gradient(DVec3::ZERO, DVec3::Z, &poly, 2.0).unwrap();
     for m in [Method::Rendering, Method::Transport, Method::Expectation] {
         let r = estimate(&scene, m, 150_000, 50);
