@@ -445,7 +445,8 @@ pub(super) fn inside(s: &Shape, p: DVec3) -> bool {
 
 /// The sensor with its direction or normal normalised; rejects a sensor
 /// that is not finite, lies on a triangle (closer than `SENSOR_DISTANCE` ×
-/// `size`) or inside an opaque closed mesh.
+/// `size`) or inside an opaque closed mesh that holds no emitter (inside
+/// one that does is a room).
 fn check_sensor(
     sensor: Sensor,
     shapes: &[Shape],
@@ -480,13 +481,24 @@ fn check_sensor(
             }
         }
     }
+    // Inside a closed opaque mesh is a room (two-sided surfaces: its inner
+    // walls are as good as its outer ones), unless no emitter is inside
+    // with the sensor: then it sees nothing, a mistake.
     for (k, s) in shapes.iter().enumerate() {
         if closed[k] && s.surface.is_opaque() && inside(s, p) {
-            return config(format!(
-                "the sensor at {} is inside the opaque shape {:?}",
-                show(p),
-                s.name
-            ));
+            let lit = shapes.iter().enumerate().any(|(l, e)| {
+                l != k
+                    && matches!(e.surface, Surface::Emitter { radiance } if radiance > 0.0)
+                    && e.vertices.first().is_some_and(|&v| inside(s, v))
+            });
+            if !lit {
+                return config(format!(
+                    "the sensor at {} is inside the opaque shape {:?}, which holds no \
+                     emitter: it would see nothing",
+                    show(p),
+                    s.name
+                ));
+            }
         }
     }
     Ok(sensor)
