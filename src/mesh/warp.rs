@@ -40,10 +40,9 @@ use std::f64::consts::PI;
 /// crossing, the crossing.
 #[derive(Debug, Clone, Copy)]
 pub struct FibreKnot {
-    /// Polar angle from the pole.
-    pub theta: f64,
-    /// Its cosine (the search compares cosines: no trigonometry).
-    cos: f64,
+    /// The cosine of its polar angle from the pole (the field is linear in
+    /// it between knots, and the search compares cosines: no trigonometry).
+    pub cos: f64,
     /// The edge crossing, or `None` for a knot moving with the frame.
     pub edge: Option<Crossing>,
 }
@@ -122,10 +121,10 @@ pub struct SpaceWarp {
 pub struct FibreField {
     /// The fibre's plane's unit normal `p × u`.
     m: DVec3,
-    /// ω's polar angle, `e_θ` there and `cot θ`.
-    theta: f64,
+    /// Cosine and sine of ω's polar angle, and `e_θ` there.
+    cos: f64,
+    sin: f64,
     e_w: DVec3,
-    cot: f64,
     /// Nearest knots below and above θ.
     lo: FibreKnot,
     hi: FibreKnot,
@@ -155,21 +154,17 @@ fn pole(x: DVec3) -> DVec3 {
 impl Space {
     /// The warp at `v` around `w`: a field per pole rule.
     pub(super) fn fibre_warp(&self, v: &Vertex<Self>, w: DVec3) -> SpaceWarp {
+        let still = FibreKnot {
+            cos: 1.0,
+            edge: None,
+        };
         let blank = FibreField {
             m: DVec3::ZERO,
-            theta: 0.0,
+            cos: 1.0,
+            sin: 0.0,
             e_w: DVec3::ZERO,
-            cot: 0.0,
-            lo: FibreKnot {
-                theta: 0.0,
-                cos: 1.0,
-                edge: None,
-            },
-            hi: FibreKnot {
-                theta: 0.0,
-                cos: 1.0,
-                edge: None,
-            },
+            lo: still,
+            hi: still,
         };
         let mut warp = SpaceWarp {
             fields: [blank; MAX_FIELDS],
@@ -188,54 +183,50 @@ impl Space {
         let c = w.dot(p).clamp(-1.0, 1.0);
         let perp = w - p * c;
         let s = perp.length();
-        let still = |t: f64| FibreKnot {
-            theta: t,
-            cos: t.cos(),
-            edge: None,
-        };
+        let still = |cos: f64| FibreKnot { cos, edge: None };
         if s < 1e-12 {
             // ω at a pole: the field is the frame's there.
-            let theta = c.acos();
             return FibreField {
                 m: DVec3::ZERO,
-                theta,
+                cos: c,
+                sin: s,
                 e_w: DVec3::ZERO,
-                cot: 0.0,
-                lo: still(theta),
-                hi: still(theta),
+                lo: still(c),
+                hi: still(c),
             };
         }
         let u = perp / s;
         let m = p.cross(u);
-        let theta = s.atan2(c);
-        // The lobe's horizon on the fibre (a knot moving with the frame):
-        // where cos θ (p·n) + sin θ (u·n) = 0.
-        let (mut lo, mut hi) = (still(0.0), still(PI));
+        // The poles, and the lobe's horizon on the fibre (knots moving with
+        // the frame): the horizon meets the fibre's great circle at ±(n × m),
+        // the fibre at the one on its side (u·h > 0).
+        let (mut lo, mut hi) = (still(1.0), still(-1.0));
         if let crate::mesh::lobe::SpaceLobe::Cosine { n, .. } = v.lobe {
-            let (a, b) = (p.dot(n), u.dot(n));
-            // θ_h in (0, π) with a cos θ_h + b sin θ_h = 0.
-            let th = (-a).atan2(b).rem_euclid(PI);
-            if th > 0.0 && th < theta && th > lo.theta {
-                lo = still(th);
-            } else if th > theta && th < hi.theta {
-                hi = still(th);
+            let h = n.cross(m);
+            let len = h.length();
+            if len > 1e-12 {
+                let h = if h.dot(u) < 0.0 { -h / len } else { h / len };
+                let ch = h.dot(p);
+                if ch > c && ch < lo.cos {
+                    lo = still(ch);
+                } else if ch < c && ch > hi.cos {
+                    hi = still(ch);
+                }
             }
         }
         let (lo, hi) = self.nearest_crossings(x, v.skip, p, u, m, c, lo, hi);
-        // The chosen crossings' angles and what the slots' rates need.
+        // What the slots' rates need at the chosen crossings.
         let finish = |k: FibreKnot| -> FibreKnot {
             let Some(e) = k.edge else { return k };
             let d = e.q - x;
-            let (dp, du) = (d.dot(p), d.dot(u));
-            let theta = du.atan2(dp);
-            let (st, ct) = theta.sin_cos();
+            let inv_r = 1.0 / d.length();
+            let wq = d * inv_r;
             let across = e.dir.dot(m);
             FibreKnot {
-                theta,
                 cos: k.cos,
                 edge: Some(Crossing {
-                    e_theta: u * ct - p * st,
-                    inv_r: 1.0 / d.length(),
+                    e_theta: u * wq.dot(p) - p * wq.dot(u),
+                    inv_r,
                     inv_across: if across == 0.0 { 0.0 } else { 1.0 / across },
                     ..e
                 }),
@@ -243,9 +234,9 @@ impl Space {
         };
         FibreField {
             m,
-            theta,
+            cos: c,
+            sin: s,
             e_w: u * c - p * s,
-            cot: c / s,
             lo: finish(lo),
             hi: finish(hi),
         }
@@ -289,7 +280,6 @@ impl Space {
                     }
                     let cos = dp / d.length();
                     let knot = FibreKnot {
-                        theta: f64::NAN,
                         cos,
                         edge: Some(Crossing {
                             q,
@@ -382,13 +372,17 @@ impl Space {
             slide.dot(e.e_theta) * e.inv_r
         };
         let (a_lo, a_hi) = (rate(&warp.lo), rate(&warp.hi));
-        let span = warp.hi.theta - warp.lo.theta;
+        // α is linear in t = −cos θ between the knots: ∂α/∂θ = slope · sin θ.
+        let span = warp.lo.cos - warp.hi.cos;
         if span <= 0.0 {
             return (rigid, 0.0);
         }
         let slope = (a_hi - a_lo) / span;
-        let alpha = a_lo + slope * (warp.theta - warp.lo.theta);
-        (rigid + warp.e_w * alpha, slope + alpha * warp.cot)
+        let alpha = a_lo + slope * (warp.lo.cos - warp.cos);
+        (
+            rigid + warp.e_w * alpha,
+            slope * warp.sin + alpha * warp.cos / warp.sin,
+        )
     }
     // ANCHOR_END: fibre_velocity
 
