@@ -134,6 +134,28 @@ fn bad_input_is_a_clear_error() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.starts_with("error:") && err.contains(needle), "{err}");
     }
+    // A phase function too peaked for the expectation method is refused
+    // for it (as in flatland), not for rendering.
+    let fog = std::fs::read_to_string(scene("fog_cube.toml"))
+        .unwrap()
+        .replace("g = 0.3", "g = 0.999");
+    let peaked = dir.join("peaked.toml");
+    std::fs::write(&peaked, fog).unwrap();
+    let run = |method: &str| {
+        geosens(&[
+            "mesh",
+            "--scene",
+            peaked.to_str().unwrap(),
+            "--method",
+            method,
+            "--paths",
+            "1000",
+        ])
+    };
+    let out = run("expectation");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("too peaked"));
+    assert!(run("rendering").status.success());
     // --fd-step belongs to fd.
     let out = geosens(&[
         "mesh",

@@ -42,12 +42,37 @@ impl Problem for Arc<Scene> {
                 let step = fd_step.map_or(Ok(DEFAULT_STEP), check_step)?;
                 return Ok(Box::new(finite_difference(&scene, step)?));
             }
-            Method::Expectation => Scheme::Expectation,
+            Method::Expectation => {
+                check_peaked_phase(&scene)?;
+                Scheme::Expectation
+            }
             Method::Rendering => Scheme::Rendering,
             Method::Transport => Scheme::Transport,
         };
         Ok(Box::new(derivative(scene, scheme)))
     }
+}
+
+/// Refuses the expectation method on a medium whose Henyey–Greenstein
+/// phase function is more peaked than flatland's limit
+/// ([`crate::flat::methods::MAX_EXPECTATION_G`]): the warp turns scattered
+/// directions relative to the incoming one, so the score carries `∂ ln p`
+/// along the warp, of order `1/(1 − |g|)`.
+fn check_peaked_phase(scene: &Scene) -> Result<(), Error> {
+    use crate::flat::methods::MAX_EXPECTATION_G;
+    for s in scene.shapes() {
+        if let Some(m) = s.medium
+            && m.g.abs() > MAX_EXPECTATION_G
+        {
+            return Err(Error::Scene(format!(
+                "mesh {:?}: Henyey–Greenstein g = {} is too peaked for the expectation method \
+                 (|g| ≤ {MAX_EXPECTATION_G}: its variance grows as 1/(1 − |g|)²); use rendering \
+                 or transport",
+                s.name, m.g
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The derivative estimator of `scheme` on `scene`.
