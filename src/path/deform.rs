@@ -399,6 +399,9 @@ impl<V: Vector> Scratch<V> {
 /// transmittance and vertex carrying act). The MIS weight is a fixed partition of unity in
 /// the method's own coordinates over directions, so it is not
 /// differentiated (book: "Next-event estimation in the derivative walks").
+/// With `precheck`, a blocked connection is found by a plain shadow walk
+/// before `direction` runs (worth it when `direction` costs more than the
+/// extra ray: the expectation method's warp); the result is the same.
 #[allow(clippy::too_many_arguments)]
 pub fn connect<G: Boundaries>(
     g: &G,
@@ -408,11 +411,18 @@ pub fn connect<G: Boundaries>(
     rng: &mut PathRng,
     v: &Vertex<G>,
     frozen: bool,
+    precheck: bool,
     direction: impl FnOnce(&mut Deform<G::V>, G::V),
 ) -> f64 {
     let Some((w, p, c)) = light_sample(g, rng, v) else {
         return 0.0;
     };
+    // A blocked connection adds nothing, whatever its direction's
+    // velocity: a direction rule that costs more than a shadow ray (the
+    // expectation method's warp) is worth skipping there.
+    if precheck && transmittance(g, &mut (), v.x, w, v.medium, v.skip, p) == 0.0 {
+        return 0.0;
+    }
     let mut tmp = scratch.take(d.len());
     tmp.copy_from(d);
     direction(&mut tmp, w);

@@ -100,6 +100,7 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
             rng,
             v,
             false,
+            true,
             |d, w| warp(g, slots, d, v, w),
         )
     }
