@@ -59,6 +59,19 @@ fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>
 }
 // ANCHOR_END: warp
 
+/// Whether the path leaving `v` along `w` surely ends without light: in
+/// vacuum, it escapes or meets a black absorber. Its direction's velocity
+/// then multiplies nothing, and the warp (which costs more than this one
+/// ray) is skipped; the estimates are unchanged.
+#[inline]
+fn dead_end<G: Geometry>(g: &G, v: &Vertex<G>, w: G::V) -> bool {
+    if g.coefficients(v.medium).is_some() {
+        return false;
+    }
+    g.cast(v.x, w, v.skip)
+        .is_none_or(|h| g.surface(h.prim) == super::Surface::Absorber)
+}
+
 impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
@@ -107,7 +120,7 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
         let w = v.lobe.sample(rng);
-        if !self.slots.is_empty() {
+        if !self.slots.is_empty() && !dead_end(g, v, w) {
             warp(g, self.slots, &mut self.d, v, w);
         }
         w
