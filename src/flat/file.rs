@@ -66,17 +66,32 @@ impl SceneFile {
 /// Reads the scene file at `path`: TOML if it ends in `.toml`, JSON if in
 /// `.json` (any case). Errors name the file.
 pub fn load(path: &Path) -> Result<Scene, Error> {
-    let in_file = |e: Error| match e {
+    parse_file(path, from_toml, from_json)
+}
+
+/// `e` with the file `path` named in its message (scene errors only).
+pub(crate) fn in_file(path: &Path, e: Error) -> Error {
+    match e {
         Error::Scene(msg) => Error::Scene(format!("{}: {msg}", path.display())),
         other => other,
-    };
+    }
+}
+
+/// The scene file at `path` parsed by `toml` or `json` after its extension
+/// (any case), at most [`MAX_SCENE_BYTES`] read; errors name the file. The
+/// flatland and the 3D loaders share it.
+pub(crate) fn parse_file<T>(
+    path: &Path,
+    toml: fn(&str) -> Result<T, Error>,
+    json: fn(&str) -> Result<T, Error>,
+) -> Result<T, Error> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let parse: fn(&str) -> Result<Scene, Error> = match ext.as_deref() {
-        Some("toml") => from_toml,
-        Some("json") => from_json,
+    let parse = match ext.as_deref() {
+        Some("toml") => toml,
+        Some("json") => json,
         _ => {
             return Err(Error::Scene(format!(
                 "{}: unknown scene file extension {:?}: expected .toml or .json",
@@ -86,7 +101,7 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
         }
     };
     let text = read_capped(path)?;
-    parse(&text).map_err(in_file)
+    parse(&text).map_err(|e| in_file(path, e))
 }
 
 /// Largest scene file read (bytes): a path that names an endless stream
@@ -95,27 +110,43 @@ pub const MAX_SCENE_BYTES: u64 = 256 << 20;
 
 /// The text of the file at `path`, at most [`MAX_SCENE_BYTES`] long.
 pub(crate) fn read_capped(path: &Path) -> Result<String, Error> {
-    use std::io::Read;
-    let cannot =
-        |e: std::io::Error| Error::Scene(format!("cannot read scene file {}: {e}", path.display()));
-    let file = std::fs::File::open(path).map_err(cannot)?;
-    let mut bytes = Vec::new();
-    file.take(MAX_SCENE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
-    if bytes.len() as u64 > MAX_SCENE_BYTES {
-        return Err(Error::Scene(format!(
+    let bytes = read_bytes_capped(path).map_err(|why| match why {
+        Unread::Io(e) => Error::Scene(format!("cannot read scene file {}: {e}", path.display())),
+        Unread::TooLarge => Error::Scene(format!(
             "scene file {} is larger than {} MiB (or an endless stream): not read",
             path.display(),
             MAX_SCENE_BYTES >> 20
-        )));
-    }
+        )),
+    })?;
     String::from_utf8(bytes).map_err(|e| {
         Error::Scene(format!(
             "cannot read scene file {}: not UTF-8 text ({e})",
             path.display()
         ))
     })
+}
+
+/// Why [`read_bytes_capped`] read nothing.
+pub(crate) enum Unread {
+    /// The file could not be opened or read.
+    Io(std::io::Error),
+    /// It holds more than [`MAX_SCENE_BYTES`].
+    TooLarge,
+}
+
+/// The bytes of the file at `path`, at most [`MAX_SCENE_BYTES`] (scene
+/// files here, OBJ meshes in `mesh::file`).
+pub(crate) fn read_bytes_capped(path: &Path) -> Result<Vec<u8>, Unread> {
+    use std::io::Read;
+    let file = std::fs::File::open(path).map_err(Unread::Io)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_SCENE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(Unread::Io)?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(Unread::TooLarge);
+    }
+    Ok(bytes)
 }
 
 /// Parses and validates a TOML scene.

@@ -46,7 +46,9 @@
 //! relative to the current directory.
 use super::scene::{Medium, Parameter, Scene, Sensor, Shape, Surface};
 use crate::error::Error;
-use crate::flat::file::{MAX_SCENE_BYTES, json_error, read_capped};
+use crate::flat::file::{
+    MAX_SCENE_BYTES, Unread, in_file, json_error, parse_file, read_bytes_capped,
+};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -161,30 +163,10 @@ impl MeshFile {
 /// `.json` (any case); OBJ paths are relative to its directory. Errors name
 /// the file.
 pub fn load(path: &Path) -> Result<Scene, Error> {
-    let in_file = |e: Error| match e {
-        Error::Scene(msg) => Error::Scene(format!("{}: {msg}", path.display())),
-        other => other,
-    };
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let parse: fn(&str) -> Result<MeshFile, Error> = match ext.as_deref() {
-        Some("toml") => parse_toml,
-        Some("json") => parse_json,
-        _ => {
-            return Err(Error::Scene(format!(
-                "{}: unknown scene file extension {:?}: expected .toml or .json",
-                path.display(),
-                path.extension().unwrap_or_default()
-            )));
-        }
-    };
-    let text = read_capped(path)?;
     let base = path.parent().unwrap_or(Path::new(""));
-    parse(&text)
-        .and_then(|f| f.into_scene(base))
-        .map_err(in_file)
+    parse_file(path, parse_toml, parse_json)?
+        .into_scene(base)
+        .map_err(|e| in_file(path, e))
 }
 
 fn parse_toml(text: &str) -> Result<MeshFile, Error> {
@@ -226,24 +208,19 @@ pub fn to_json(scene: &Scene) -> Result<String, Error> {
 /// The vertices and triangles of the OBJ file at `path` for shape `name`:
 /// all its objects merged, polygons triangulated.
 fn read_obj(path: &Path, name: &str) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), Error> {
-    use std::io::Read;
     let fail = |why: String| {
         Error::Scene(format!(
             "shape {name:?}: cannot read mesh file {}: {why}",
             path.display()
         ))
     };
-    let file = std::fs::File::open(path).map_err(|e| fail(e.to_string()))?;
-    let mut bytes = Vec::new();
-    file.take(MAX_SCENE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| fail(e.to_string()))?;
-    if bytes.len() as u64 > MAX_SCENE_BYTES {
-        return Err(fail(format!(
+    let bytes = read_bytes_capped(path).map_err(|why| match why {
+        Unread::Io(e) => fail(e.to_string()),
+        Unread::TooLarge => fail(format!(
             "larger than {} MiB (or an endless stream)",
             MAX_SCENE_BYTES >> 20
-        )));
-    }
+        )),
+    })?;
     let options = tobj::LoadOptions {
         triangulate: true,
         ignore_points: true,
