@@ -30,6 +30,25 @@ fn estimate(scene: &Arc<Scene>, m: Method, n: u64, seed: u64) -> geosens::RunRes
     run(e.as_ref(), &RunConfig::new(n, seed).unwrap()).unwrap()
 }
 
+/// `m`'s estimate of `∂I/∂name` in `r` against finite differences in
+/// `fd`: printed, and within 4 combined standard errors; returns both.
+fn against_fd(
+    m: Method,
+    name: &str,
+    r: &geosens::RunResult,
+    fd: &geosens::RunResult,
+) -> (geosens::Estimate, geosens::Estimate) {
+    let q = Quantity::sensitivity(name);
+    let (a, b) = (r.get(&q).unwrap(), fd.get(&q).unwrap());
+    let z = (a.mean - b.mean) / a.stderr.hypot(b.stderr);
+    eprintln!(
+        "{m} {name}: {:.5} ± {:.5} vs fd {:.5} ± {:.5} (z {z:.2})",
+        a.mean, a.stderr, b.mean, b.stderr
+    );
+    assert!(z.abs() < 4.0, "{m} {name}: {a:?} vs fd {b:?}");
+    (a, b)
+}
+
 #[test]
 fn every_method_gives_the_lamps_irradiance() {
     let scene = Arc::new(Scene::new(vec![lamp()], vec![], up()).unwrap());
@@ -84,14 +103,7 @@ fn occluders_sensitivities_match_finite_differences() {
         for m in [Method::Rendering, Method::Transport, Method::Expectation] {
             let r = estimate(&scene, m, 400_000, 5);
             for (name, _) in motions {
-                let q = Quantity::sensitivity(name);
-                let (a, b) = (r.get(&q).unwrap(), fd.get(&q).unwrap());
-                let z = (a.mean - b.mean) / a.stderr.hypot(b.stderr);
-                eprintln!(
-                    "{m} {name}: {:.5} ± {:.5} vs fd {:.5} ± {:.5} (z {z:.2})",
-                    a.mean, a.stderr, b.mean, b.stderr
-                );
-                assert!(z.abs() < 4.0, "{m} {name}: {a:?} vs fd {b:?}");
+                against_fd(m, name, &r, &fd);
             }
         }
     }
@@ -128,14 +140,7 @@ fn fog_cubes_sensitivities_match_finite_differences() {
         for m in [Method::Rendering, Method::Transport, Method::Expectation] {
             let r = estimate(&scene, m, 150_000, 6);
             for (name, _) in motions {
-                let q = Quantity::sensitivity(name);
-                let (a, b) = (r.get(&q).unwrap(), fd.get(&q).unwrap());
-                let z = (a.mean - b.mean) / a.stderr.hypot(b.stderr);
-                eprintln!(
-                    "{m} {name}: {:.5} ± {:.5} vs fd {:.5} ± {:.5} (z {z:.2})",
-                    a.mean, a.stderr, b.mean, b.stderr
-                );
-                assert!(z.abs() < 4.0, "{m} {name}: {a:?} vs fd {b:?}");
+                against_fd(m, name, &r, &fd);
             }
         }
     }
@@ -502,14 +507,7 @@ fn a_mesh_inside_a_medium_matches_finite_differences() {
     for m in [Method::Rendering, Method::Transport, Method::Expectation] {
         let r = estimate(&scene, m, 150_000, 41);
         for (name, _) in motions {
-            let q = Quantity::sensitivity(name);
-            let (a, b) = (r.get(&q).unwrap(), fd.get(&q).unwrap());
-            let z = (a.mean - b.mean) / a.stderr.hypot(b.stderr);
-            eprintln!(
-                "{m} {name}: {:.5} ± {:.5} vs fd {:.5} ± {:.5} (z {z:.2})",
-                a.mean, a.stderr, b.mean, b.stderr
-            );
-            assert!(z.abs() < 4.0, "{m} {name}: {a:?} vs fd {b:?}");
+            let (_, b) = against_fd(m, name, &r, &fd);
             assert!(b.stderr < 0.1 * b.mean.abs(), "fd {name}: {b:?}");
         }
     }
@@ -695,14 +693,7 @@ fn a_reflecting_room_matches_finite_differences() {
     for m in [Method::Rendering, Method::Transport, Method::Expectation] {
         let r = estimate(&scene, m, 150_000, 61);
         for p in &parameters {
-            let q = Quantity::sensitivity(&p.name);
-            let (a, b) = (r.get(&q).unwrap(), fd.get(&q).unwrap());
-            let z = (a.mean - b.mean) / a.stderr.hypot(b.stderr);
-            eprintln!(
-                "{m} {}: {:.5} ± {:.5} vs fd {:.5} ± {:.5} (z {z:.2})",
-                p.name, a.mean, a.stderr, b.mean, b.stderr
-            );
-            assert!(z.abs() < 4.0, "{m} {}: {a:?} vs fd {b:?}", p.name);
+            let (a, b) = against_fd(m, &p.name, &r, &fd);
             if p.shape == "occ" {
                 assert!(b.stderr < 0.15 * b.mean.abs(), "fd {}: {b:?}", p.name);
                 assert!(a.stderr < 0.1 * a.mean.abs(), "{m} {}: {a:?}", p.name);
