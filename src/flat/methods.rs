@@ -69,15 +69,23 @@ fn check_peaked_phase(scene: &Scene) -> Result<(), Error> {
             phase: super::Phase::HenyeyGreenstein { g },
             ..
         }) = s.medium
-            && g.abs() > MAX_EXPECTATION_G
         {
-            return Err(Error::Scene(format!(
-                "shape {:?}: Henyey–Greenstein g = {g} is too peaked for the expectation \
-                 method (|g| ≤ {MAX_EXPECTATION_G}: its variance grows as 1/(1 − |g|)²); \
-                 use rendering or transport",
-                s.name
-            )));
+            check_expectation_g("shape", &s.name, g)?;
         }
+    }
+    Ok(())
+}
+
+/// Refuses a Henyey–Greenstein `g` beyond [`MAX_EXPECTATION_G`] for the
+/// expectation method, naming the `kind` ("shape", "mesh") `name` holding
+/// it; flatland and 3D share it.
+pub(crate) fn check_expectation_g(kind: &str, name: &str, g: f64) -> Result<(), Error> {
+    if g.abs() > MAX_EXPECTATION_G {
+        return Err(Error::Scene(format!(
+            "{kind} {name:?}: Henyey–Greenstein g = {g} is too peaked for the expectation \
+             method (|g| ≤ {MAX_EXPECTATION_G}: its variance grows as 1/(1 − |g|)²); \
+             use rendering or transport"
+        )));
     }
     Ok(())
 }

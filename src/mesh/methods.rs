@@ -55,21 +55,13 @@ impl Problem for Arc<Scene> {
 
 /// Refuses the expectation method on a medium whose Henyey–Greenstein
 /// phase function is more peaked than flatland's limit
-/// ([`crate::flat::methods::MAX_EXPECTATION_G`]): the warp turns scattered
+/// ([`crate::flat::methods::MAX_EXPECTATION_G`], the same check): the warp turns scattered
 /// directions relative to the incoming one, so the score carries `∂ ln p`
 /// along the warp, of order `1/(1 − |g|)`.
 fn check_peaked_phase(scene: &Scene) -> Result<(), Error> {
-    use crate::flat::methods::MAX_EXPECTATION_G;
     for s in scene.shapes() {
-        if let Some(m) = s.medium
-            && m.g.abs() > MAX_EXPECTATION_G
-        {
-            return Err(Error::Scene(format!(
-                "mesh {:?}: Henyey–Greenstein g = {} is too peaked for the expectation method \
-                 (|g| ≤ {MAX_EXPECTATION_G}: its variance grows as 1/(1 − |g|)²); use rendering \
-                 or transport",
-                s.name, m.g
-            )));
+        if let Some(m) = s.medium {
+            crate::flat::methods::check_expectation_g("mesh", &s.name, m.g)?;
         }
     }
     Ok(())
