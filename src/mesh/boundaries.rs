@@ -24,7 +24,7 @@ impl Space {
     /// `e`, pointing from the edge into the face.
     #[inline]
     fn face_inward(&self, e: usize, p: Prim) -> DVec3 {
-        let edge = &self.edges[e];
+        let edge = &self.edge_tables().edges[e];
         let t = &self.tris[p as usize];
         let along = (edge.b - edge.a).normalize();
         // The face's vertex off the edge: the one farthest from its line.
@@ -48,13 +48,18 @@ impl Boundaries for Space {
     #[inline]
     fn sample_boundary(&self, x: DVec3, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
         let tree = if all {
-            &self.all_edges
+            &self.edge_tables().all_edges
         } else {
-            &self.moving_edges
+            &self.edge_tables().moving_edges
         };
-        let (index, p, along) =
-            tree.sample(x, u, &self.edges, &self.edge_facts, &self.edge_weight)?;
-        let edge = &self.edges[index as usize];
+        let (index, p, along) = tree.sample(
+            x,
+            u,
+            &self.edge_tables().edges,
+            &self.edge_tables().edge_facts,
+            &self.edge_tables().edge_weight,
+        )?;
+        let edge = &self.edge_tables().edges[index as usize];
         // The point: uniform in angle along the edge's arc seen from x, so
         // a long edge is sampled where it subtends the most (uniform in
         // length, its far parts would be drawn as often as its near ones
@@ -98,7 +103,7 @@ impl Boundaries for Space {
         let n = self.boundary_normal(x, b);
         let e = b.index as usize;
         let (mut ahead, mut behind) = ((f64::INFINITY, Side::Past), (f64::INFINITY, Side::Past));
-        for p in self.edges[e].faces {
+        for p in self.edge_tables().edges[e].faces {
             if p == NO_PRIM {
                 continue;
             }
@@ -120,7 +125,7 @@ impl Boundaries for Space {
     /// `ω × ê / |ω × ê|`: normal to the edge's arc on the sphere at `ω`.
     #[inline]
     fn boundary_normal(&self, x: DVec3, b: &BoundaryPoint<DVec3>) -> DVec3 {
-        let edge = &self.edges[b.index as usize];
+        let edge = &self.edge_tables().edges[b.index as usize];
         let w = (b.q - x).normalize();
         w.cross(edge.b - edge.a).normalize_or_zero()
     }

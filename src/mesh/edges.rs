@@ -23,7 +23,6 @@
 use super::space::Edge;
 use crate::path::NO_PRIM;
 use glam::DVec3;
-use std::f64::consts::FRAC_PI_2;
 
 /// Most edges in a leaf.
 const LEAF: usize = 4;
@@ -132,21 +131,23 @@ impl EdgeTree {
             weight += weights[i as usize];
         }
         let axis = sum.normalize_or_zero();
-        let half_angle = if axis == DVec3::ZERO {
-            std::f64::consts::PI
+        // The cone's half-angle by its cosine, the least n·axis (no acos per
+        // normal: the build runs over every edge at every level).
+        let cos_half = if axis == DVec3::ZERO {
+            -1.0
         } else {
             ids.iter()
                 .flat_map(|&i| facts[i as usize].normals)
-                .map(|n| n.dot(axis).clamp(-1.0, 1.0).acos())
-                .fold(0.0, f64::max)
+                .map(|n| n.dot(axis).clamp(-1.0, 1.0))
+                .fold(1.0, f64::min)
         };
         let mut this = Node {
             lo,
             hi,
             axis,
-            cos_half: half_angle.cos(),
-            sin_half: half_angle.sin(),
-            unbounded: half_angle >= FRAC_PI_2,
+            cos_half,
+            sin_half: (1.0 - cos_half * cos_half).max(0.0).sqrt(),
+            unbounded: cos_half <= 0.0,
             always,
             weight,
             first: start as u32,

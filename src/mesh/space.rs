@@ -14,7 +14,7 @@ use crate::rng::PathRng;
 use glam::DVec3;
 use rand::RngExt;
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// An edge of an opaque mesh: where the integrand over directions seen from
 /// a point can jump (a silhouette, an open edge, or a crease between two
@@ -50,7 +50,21 @@ pub struct Space {
     /// Emitting triangles with their cumulative area, and the total.
     emitters: Vec<(Prim, f64)>,
     emitter_area: f64,
-    /// The edges of opaque meshes that can be discontinuities.
+    /// The edges and their hierarchies, built on first use: only the
+    /// derivative methods ask (not the intensity estimator, nor the
+    /// displaced scenes of finite differences).
+    edge_tables: OnceLock<EdgeTables>,
+    /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
+    /// parameter the index of its rule.
+    pub(super) pole_rules: Vec<PoleRule>,
+    pub(super) slot_field: Vec<u8>,
+}
+
+/// The edges of the opaque meshes that can be discontinuities, with what
+/// the boundary terms and the warp need of them.
+#[derive(Debug, Clone)]
+pub(super) struct EdgeTables {
+    /// The edges.
     pub(super) edges: Vec<Edge>,
     /// Per edge, the weight with which the boundary terms draw it: its
     /// length times `θ/π` (θ the angle between its faces' normals; 1 for an
@@ -62,10 +76,6 @@ pub struct Space {
     /// The hierarchies over all edges and over those of moving meshes.
     pub(super) all_edges: EdgeTree,
     pub(super) moving_edges: EdgeTree,
-    /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
-    /// parameter the index of its rule.
-    pub(super) pole_rules: Vec<PoleRule>,
-    pub(super) slot_field: Vec<u8>,
 }
 
 impl Space {
@@ -74,16 +84,109 @@ impl Space {
         let mut tris = Vec::new();
         let mut owner = Vec::new();
         let mut normals = Vec::new();
-        let mut edges = Vec::new();
-        let mut edge_weight = Vec::new();
         for (k, s) in scene.shapes().iter().enumerate() {
-            let first = tris.len() as u32;
             for i in 0..s.triangles.len() {
                 let t = s.triangle(i);
                 tris.push(t);
                 owner.push(k as u32);
                 normals.push((t[1] - t[0]).cross(t[2] - t[0]).normalize());
             }
+        }
+        let mut opaque_tris = Vec::new();
+        let opaque_index = (0..tris.len())
+            .map(|i| {
+                if scene.shapes()[owner[i] as usize].surface.is_opaque() {
+                    opaque_tris.push(tris[i]);
+                    (opaque_tris.len() - 1) as u32
+                } else {
+                    NO_PRIM
+                }
+            })
+            .collect();
+        let mut emitter_area = 0.0;
+        let emitters = (0..tris.len())
+            .filter(|&i| {
+                matches!(scene.shapes()[owner[i] as usize].surface, Surface::Emitter { radiance } if radiance > 0.0)
+            })
+            .map(|i| {
+                let t = tris[i];
+                emitter_area += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                (i as Prim, emitter_area)
+            })
+            .collect();
+        let mut pole_rules = vec![PoleRule::Hashed];
+        let mut slot_field = scene
+            .parameters()
+            .iter()
+            .map(|p| {
+                let rule = PoleRule::of(&p.motion);
+                match pole_rules.iter().position(|r| *r == rule) {
+                    Some(i) => i as u8,
+                    None if pole_rules.len() < MAX_FIELDS => {
+                        pole_rules.push(rule);
+                        (pole_rules.len() - 1) as u8
+                    }
+                    None => 0,
+                }
+            })
+            .collect::<Vec<u8>>();
+        // The pseudo-random family only if some parameter uses it.
+        if !slot_field.contains(&0) && pole_rules.len() > 1 {
+            pole_rules.remove(0);
+            for i in &mut slot_field {
+                *i -= 1;
+            }
+        }
+        Space {
+            caster: TriangleBvh::new(tris.clone()),
+            opaque: TriangleBvh::new(opaque_tris),
+            opaque_index,
+            scene,
+            tris,
+            owner,
+            normals,
+            emitters,
+            emitter_area,
+            edge_tables: OnceLock::new(),
+            pole_rules,
+            slot_field,
+        }
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// The edges that can be discontinuities.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edge_tables().edges
+    }
+
+    /// The edge tables, built on first use.
+    #[inline]
+    pub(super) fn edge_tables(&self) -> &EdgeTables {
+        self.edge_tables
+            .get_or_init(|| EdgeTables::new(&self.scene, &self.normals))
+    }
+
+    /// Total area of the emitters.
+    pub fn emitter_area(&self) -> f64 {
+        self.emitter_area
+    }
+}
+
+impl EdgeTables {
+    /// The edges of `scene`'s opaque meshes (`normals`: per triangle, in
+    /// [`Space`]'s order), their weights and facts, and their hierarchies.
+    fn new(scene: &Scene, normals: &[DVec3]) -> EdgeTables {
+        let mut edges = Vec::new();
+        let mut edge_weight = Vec::new();
+        let mut first = 0u32;
+        for (k, s) in scene.shapes().iter().enumerate() {
+            let first_of_shape = first;
+            first += s.triangles.len() as u32;
+            let first = first_of_shape;
             if !s.surface.is_opaque() {
                 continue;
             }
@@ -128,28 +231,6 @@ impl Space {
                 }
             }
         }
-        let mut opaque_tris = Vec::new();
-        let opaque_index = (0..tris.len())
-            .map(|i| {
-                if scene.shapes()[owner[i] as usize].surface.is_opaque() {
-                    opaque_tris.push(tris[i]);
-                    (opaque_tris.len() - 1) as u32
-                } else {
-                    NO_PRIM
-                }
-            })
-            .collect();
-        let mut emitter_area = 0.0;
-        let emitters = (0..tris.len())
-            .filter(|&i| {
-                matches!(scene.shapes()[owner[i] as usize].surface, Surface::Emitter { radiance } if radiance > 0.0)
-            })
-            .map(|i| {
-                let t = tris[i];
-                emitter_area += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-                (i as Prim, emitter_area)
-            })
-            .collect();
         let params = scene.parameters().len();
         let moving = |k: u32| (0..params).any(|j| scene.parameter_shape(j) == k);
         let edge_facts: Vec<EdgeFacts> = edges
@@ -176,64 +257,15 @@ impl Space {
         let moving_ids: Vec<u32> = (0..edges.len() as u32)
             .filter(|&i| moving(edges[i as usize].shape))
             .collect();
-        let mut pole_rules = vec![PoleRule::Hashed];
-        let mut slot_field = scene
-            .parameters()
-            .iter()
-            .map(|p| {
-                let rule = PoleRule::of(&p.motion);
-                match pole_rules.iter().position(|r| *r == rule) {
-                    Some(i) => i as u8,
-                    None if pole_rules.len() < MAX_FIELDS => {
-                        pole_rules.push(rule);
-                        (pole_rules.len() - 1) as u8
-                    }
-                    None => 0,
-                }
-            })
-            .collect::<Vec<u8>>();
-        // The pseudo-random family only if some parameter uses it.
-        if !slot_field.contains(&0) && pole_rules.len() > 1 {
-            pole_rules.remove(0);
-            for i in &mut slot_field {
-                *i -= 1;
-            }
-        }
         let all_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, all_ids);
         let moving_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, moving_ids);
-        Space {
-            caster: TriangleBvh::new(tris.clone()),
-            opaque: TriangleBvh::new(opaque_tris),
-            opaque_index,
-            scene,
-            tris,
-            owner,
-            normals,
-            emitters,
-            emitter_area,
+        EdgeTables {
             edges,
             edge_weight,
             edge_facts,
             all_edges,
             moving_edges,
-            pole_rules,
-            slot_field,
         }
-    }
-
-    /// The scene.
-    pub fn scene(&self) -> &Arc<Scene> {
-        &self.scene
-    }
-
-    /// The edges that can be discontinuities.
-    pub fn edges(&self) -> &[Edge] {
-        &self.edges
-    }
-
-    /// Total area of the emitters.
-    pub fn emitter_area(&self) -> f64 {
-        self.emitter_area
     }
 }
 

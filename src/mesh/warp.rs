@@ -264,9 +264,14 @@ impl Space {
         let (mut done_lo, mut done_hi) = (false, false);
         while !(done_lo && done_hi) {
             let (mut best_lo, mut best_hi): (Option<FibreKnot>, Option<FibreKnot>) = (None, None);
-            self.all_edges
-                .crossings(x, m, u, &self.edges, &self.edge_facts, |i| {
-                    let e = &self.edges[i as usize];
+            self.edge_tables().all_edges.crossings(
+                x,
+                m,
+                u,
+                &self.edge_tables().edges,
+                &self.edge_tables().edge_facts,
+                |i| {
+                    let e = &self.edge_tables().edges[i as usize];
                     let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
                     if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
                         return;
@@ -304,7 +309,8 @@ impl Space {
                     {
                         best_hi = Some(knot);
                     }
-                });
+                },
+            );
             let settle =
                 |done: &mut bool, best: Option<FibreKnot>, bound: &mut f64, k: &mut FibreKnot| {
                     if *done {
