@@ -7,8 +7,9 @@
 //! parameters gets its twelve sensitivities from the same call, and the hot
 //! loop allocates nothing. The [`runner`](crate::runner) turns the weights
 //! into estimates.
+use crate::path::PixelSample;
 use crate::rng::PathRng;
-use crate::stats::ChunkSums;
+use crate::stats::{ChunkSums, StratumSums};
 use serde::Serialize;
 use std::fmt;
 
@@ -69,6 +70,30 @@ pub trait Estimator: Sync {
         Vec::new()
     }
 
+    /// For a camera sensor: the image's `(width, height)`; the runner's
+    /// [`render`](crate::image::render) then estimates every pixel. `None`
+    /// (the default) for a probe.
+    fn image(&self) -> Option<(u32, u32)> {
+        None
+    }
+
+    /// Samples one path through `pixel` (a camera's); other sensors ignore
+    /// it, and so does the default.
+    fn sample_pixel(&self, rng: &mut PathRng, pixel: PixelSample, weights: &mut [f64]) {
+        let _ = pixel;
+        self.sample(rng, weights);
+    }
+
+    /// Samples `spp` paths through pixel `pixel`, stratified over its
+    /// footprint ([`stratified`]), and adds their weights to `sums`.
+    #[inline]
+    fn accumulate_pixel(&self, rng: &mut PathRng, pixel: u32, spp: u64, sums: &mut [StratumSums]) {
+        let mut w = vec![0.0; sums.len()];
+        stratified(pixel, spp, sums, &mut w, |s, w| {
+            self.sample_pixel(rng, s, w)
+        });
+    }
+
     /// Samples `paths` paths and adds their weights to `sums` (one
     /// accumulator per quantity). This provided loop is compiled once per
     /// estimator, so even through `dyn Estimator` the runner pays one
@@ -82,6 +107,56 @@ pub trait Estimator: Sync {
             for (s, &x) in sums.iter_mut().zip(&w) {
                 s.push(x);
             }
+        }
+    }
+}
+
+/// Fewest samples in a stratum: each stratum's variance is estimated from
+/// its own samples, and with two a stratum that a feature covers in part
+/// often shows none of it (both samples alike: variance 0); with eight the
+/// error bar of a pixel rarely hides what its samples could see.
+pub const STRATUM_SAMPLES: u64 = 8;
+
+/// Strata per side for `spp` samples of a pixel: the largest `m` with at
+/// least [`STRATUM_SAMPLES`] samples in each of the `m²` strata; 1 below
+/// 32 samples.
+pub fn strata_per_side(spp: u64) -> u64 {
+    let mut m = ((spp / STRATUM_SAMPLES) as f64).sqrt().floor().max(1.0) as u64;
+    while m > 1 && STRATUM_SAMPLES * m * m > spp {
+        m -= 1;
+    }
+    m
+}
+
+/// Samples `spp` paths through `pixel` stratified over its footprint,
+/// `sample` writing each path's weights into `w`, and adds them to `sums`
+/// (one per quantity): stratum `s` of the `m²` ([`strata_per_side`]) gets
+/// `⌊spp/m²⌋` paths, one more for the first `spp mod m²`, in turn.
+#[inline]
+pub fn stratified(
+    pixel: u32,
+    spp: u64,
+    sums: &mut [StratumSums],
+    w: &mut [f64],
+    mut sample: impl FnMut(PixelSample, &mut [f64]),
+) {
+    let m = strata_per_side(spp);
+    let cells = m * m;
+    let (base, extra) = (spp / cells, spp % cells);
+    for stratum in 0..cells {
+        let s = PixelSample {
+            pixel,
+            stratum: stratum as u32,
+            strata: m as u32,
+        };
+        for _ in 0..base + u64::from(stratum < extra) {
+            sample(s, w);
+            for (s, &x) in sums.iter_mut().zip(w.iter()) {
+                s.push(x);
+            }
+        }
+        for s in sums.iter_mut() {
+            s.end_stratum();
         }
     }
 }

@@ -10,6 +10,7 @@
 //! shows both.
 use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
+use crate::path::PixelSample;
 use crate::rng::PathRng;
 
 /// Default half step of [`Method::Fd`](crate::Method::Fd): relative to the
@@ -134,11 +135,16 @@ impl CentralDifference {
 /// One run's weight of `I`: from `own` (the chunk's generator) if no run of
 /// this sample has used it yet, else from a copy of `start`.
 #[inline]
-fn intensity(e: &dyn Estimator, own: &mut Option<&mut PathRng>, start: &PathRng) -> f64 {
+fn intensity(
+    e: &dyn Estimator,
+    own: &mut Option<&mut PathRng>,
+    start: &PathRng,
+    pixel: PixelSample,
+) -> f64 {
     let mut w = [0.0];
     match own.take() {
-        Some(rng) => e.sample(rng, &mut w),
-        None => e.sample(&mut start.clone(), &mut w),
+        Some(rng) => e.sample_pixel(rng, pixel, &mut w),
+        None => e.sample_pixel(&mut start.clone(), pixel, &mut w),
     }
     w[0]
 }
@@ -166,17 +172,29 @@ impl Estimator for CentralDifference {
     }
 
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
+        self.sample_pixel(rng, PixelSample::default(), weights);
+    }
+
+    /// The nominal problem's image (the displaced ones share its camera).
+    fn image(&self) -> Option<(u32, u32)> {
+        match &self.nominal {
+            Some(n) => n.image(),
+            None => self.pairs.first().and_then(|p| p.plus.image()),
+        }
+    }
+
+    fn sample_pixel(&self, rng: &mut PathRng, pixel: PixelSample, weights: &mut [f64]) {
         let start = rng.clone();
         let mut own = Some(rng);
         let mut slots = weights.iter_mut();
         if let Some(nominal) = &self.nominal
             && let Some(w) = slots.next()
         {
-            *w = intensity(nominal.as_ref(), &mut own, &start);
+            *w = intensity(nominal.as_ref(), &mut own, &start, pixel);
         }
         for (pair, w) in self.pairs.iter().zip(slots) {
-            let plus = intensity(pair.plus.as_ref(), &mut own, &start);
-            let minus = intensity(pair.minus.as_ref(), &mut own, &start);
+            let plus = intensity(pair.plus.as_ref(), &mut own, &start, pixel);
+            let minus = intensity(pair.minus.as_ref(), &mut own, &start, pixel);
             *w = (plus - minus) / (2.0 * pair.half_step);
         }
     }

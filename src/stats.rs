@@ -102,6 +102,57 @@ impl ChunkSums {
 /// An even central moment, whose rounding may leave it slightly below 0,
 /// clamped at 0; NaN and ±∞ (overflowed power sums) pass through, unlike
 /// `f64::max`, which would turn NaN into 0.
+/// The sums of one pixel's stratified samples, for one quantity: the
+/// current stratum's [`ChunkSums`], and over the strata closed so far the
+/// sum of their means, of their means' variances, and their pooled
+/// moments. Equal-area strata: the pixel's mean is the mean of the strata's
+/// means, its variance `Σ_s (s_s² / n_s) / S²` (`s_s²` the stratum's sample
+/// variance); the reliability diagnostics (VOV, non-zero count, largest
+/// share) come from the pooled weights.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StratumSums {
+    stratum: ChunkSums,
+    pooled: Moments,
+    means: f64,
+    variances: f64,
+    strata: u32,
+}
+
+impl StratumSums {
+    /// Adds one weight to the current stratum.
+    #[inline]
+    pub fn push(&mut self, w: f64) {
+        self.stratum.push(w);
+    }
+
+    /// Closes the current stratum (it must hold two weights or more for
+    /// its variance).
+    pub fn end_stratum(&mut self) {
+        let m = self.stratum.moments();
+        let n = m.n as f64;
+        self.means += m.mean;
+        self.variances += m.m2 / ((n - 1.0) * n);
+        self.pooled = self.pooled.merge(&m);
+        self.strata += 1;
+        self.stratum = ChunkSums::default();
+    }
+
+    /// The moments of every weight of the closed strata, pooled.
+    pub fn pooled(&self) -> Moments {
+        self.pooled
+    }
+
+    /// The pixel's estimate.
+    pub fn estimate(&self) -> Estimate {
+        let s = f64::from(self.strata.max(1));
+        Estimate {
+            mean: self.means / s,
+            stderr: self.variances.sqrt() / s,
+            ..self.pooled.estimate()
+        }
+    }
+}
+
 #[inline]
 fn rounding_floor(v: f64) -> f64 {
     if v < 0.0 { 0.0 } else { v }

@@ -30,6 +30,7 @@ use geosens::flat::geometry::{Segment, cross, direction, perp};
 use geosens::flat::lobe::FlatLobe;
 use geosens::flat::space::Plane;
 use geosens::flat::{Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface};
+use geosens::path::walk::{Frame, Vertex};
 use geosens::path::{Boundaries, Geometry, Lobe};
 use geosens::rng::{PathRng, free_path, stream};
 use glam::DVec2;
@@ -596,10 +597,21 @@ fn corners_are_drawn_by_weight() {
         let total: f64 = weights.iter().map(share).sum();
         let mut counts = vec![0u64; weights.len()];
         let mut rng = stream(800 + u64::from(all), 0);
+        let v = Vertex::<Plane> {
+            x: DVec2::ZERO,
+            medium: None,
+            skip: geosens::path::NO_PRIM,
+            lobe: FlatLobe::Cosine {
+                n: DVec2::Y,
+                c: 1.0,
+            },
+            frame: Frame::Sensor,
+            w_in: DVec2::ZERO,
+            beta: 1.0,
+            at_sensor: false,
+        };
         for _ in 0..N {
-            let b = plane
-                .sample_boundary(DVec2::ZERO, all, rng.random())
-                .unwrap();
+            let b = plane.sample_boundary(&v, all, rng.random()).unwrap();
             let i = b.index as usize;
             assert_eq!((b.q, b.shape), scene.corners()[i]);
             let w = share(&weights[i]);

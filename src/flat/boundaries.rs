@@ -35,7 +35,12 @@ impl Boundaries for Plane {
     #[inline]
     /// A corner drawn with probability proportional to its weight (a binary
     /// search in the cumulative weights).
-    fn sample_boundary(&self, _x: DVec2, all: bool, u: f64) -> Option<BoundaryPoint<DVec2>> {
+    fn sample_boundary(
+        &self,
+        _v: &Vertex<Self>,
+        all: bool,
+        u: f64,
+    ) -> Option<BoundaryPoint<DVec2>> {
         let cdf = if all { &self.all_cdf } else { &self.moving_cdf };
         let total = *cdf.last()?;
         if total <= 0.0 {

@@ -13,6 +13,7 @@
 //! goes into the boundary point, so the path core's corner term
 //! (`rendering::corner_jump`) is, unchanged, the edge term.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
+use super::lobe::SpaceLobe;
 use super::space::Space;
 use super::warp::SpaceWarp;
 use crate::path::walk::Vertex;
@@ -40,13 +41,58 @@ impl Space {
     }
 }
 
+impl Space {
+    /// A point on the moving edges seen through the footprint `rect` of
+    /// camera pixel `pixel` from the pinhole `x`: uniform in image-plane
+    /// length, `inv_pdf` per unit arc length on the sphere (the image
+    /// plane's length `L` over the pieces, times the arc's rate
+    /// `|T − ω(ω·T)| / |ξ|` per unit image length along the piece's
+    /// direction `T`).
+    fn pixel_boundary(
+        &self,
+        x: DVec3,
+        pixel: u32,
+        rect: &[f64; 4],
+        u: f64,
+    ) -> Option<BoundaryPoint<DVec3>> {
+        let cam = self.camera.as_ref()?;
+        let (index, p, dir, total) = self.pixel_edges().sample(pixel, rect, u)?;
+        let xi = cam.f + cam.r * p[0] + cam.u * p[1];
+        let len = xi.length();
+        let w = xi / len;
+        let t = cam.r * dir[0] + cam.u * dir[1];
+        let rate = (t - w * w.dot(t)).length() / len;
+        let edge = &self.edge_tables().edges[index as usize];
+        let (ra, d) = (edge.a - x, edge.b - edge.a);
+        let n = ra.cross(edge.b - x);
+        let tau = (-(ra.cross(w).dot(n)) / d.cross(w).dot(n)).clamp(0.0, 1.0);
+        let q = edge.a + d * tau;
+        if !q.is_finite() || rate.is_nan() || rate <= 0.0 {
+            return None;
+        }
+        Some(BoundaryPoint {
+            q,
+            shape: edge.shape,
+            index,
+            inv_pdf: total * rate,
+        })
+    }
+}
+
 impl Boundaries for Space {
     // ANCHOR: sample_boundary
     /// An edge drawn from the edge hierarchy (by weight among those that
     /// can be discontinuities seen from `x`), a point uniformly along it;
     /// `inv_pdf` is per unit arc length on the sphere seen from `x`.
     #[inline]
-    fn sample_boundary(&self, x: DVec3, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
+    fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
+        if let SpaceLobe::Pixel { rect, pixel, .. } = v.lobe {
+            // The camera stands still: only moving edges move across a
+            // pixel (`all` cannot be set there).
+            debug_assert!(!all, "a camera does not move");
+            return self.pixel_boundary(v.x, pixel, &rect, u);
+        }
+        let x = v.x;
         let tree = if all {
             &self.edge_tables().all_edges
         } else {

@@ -9,7 +9,7 @@
 //!   randomised, the jump evaluated exactly at the edge;
 //! - [`Method::Transport`]: the coupled models of `s` and `∇I` with sources
 //!   on the moving boundaries; it also returns `∂I/∂x`, `∂I/∂y`, `∂I/∂z` at
-//!   the sensor;
+//!   the sensor (not for a camera);
 //! - [`Method::Fd`]: central differences with common random numbers, one
 //!   pair of displaced scenes per parameter;
 //! - [`Method::Expectation`]: the same paths deformed by the fibre warp on
@@ -69,7 +69,10 @@ fn check_peaked_phase(scene: &Scene) -> Result<(), Error> {
 
 /// The derivative estimator of `scheme` on `scene`.
 pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Space> {
-    let gradient = scheme == Scheme::Transport;
+    // The sensor position's gradient at a probe; a camera's images are of
+    // the parameters only.
+    let camera = matches!(scene.sensor(), super::Sensor::Camera(_));
+    let gradient = scheme == Scheme::Transport && !camera;
     let mut names: Vec<Quantity> = scene
         .parameters()
         .iter()

@@ -9,11 +9,14 @@
 //! - [`space`]: the scene behind the path core's `Geometry`; [`lobe`]: the
 //!   3D lobes; [`boundaries`]: the edges behind `Boundaries`; [`warp`]: the
 //!   expectation method's fibre warp;
+//! - [`camera`]: the pinhole camera (pixels as lobes, the edges each
+//!   pixel sees);
 //! - [`methods`]: the estimators; [`exact`]: closed-form references;
 //!   [`cases`]: scenes built in code for the figures and `geosens compare`
 //!   (the figures themselves: `figures`, with the `figures` feature).
 pub mod boundaries;
 pub mod bvh;
+pub mod camera;
 pub mod cases;
 pub mod edges;
 pub mod exact;

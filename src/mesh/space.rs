@@ -5,11 +5,12 @@
 //! [`Boundaries`](crate::path::Boundaries)) are in
 //! [`boundaries`](super::boundaries). Book: chapter "Three dimensions".
 use super::bvh::TriangleBvh;
+use super::camera::{CameraFrame, PixelEdges};
 use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
 use super::scene::{Scene, Sensor as SceneSensor};
 use super::warp::{MAX_FIELDS, PoleRule};
-use crate::path::{Geometry, Hit, MediumId, NO_PRIM, Prim, Sensor, Surface};
+use crate::path::{Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec3;
 use rand::RngExt;
@@ -54,6 +55,10 @@ pub struct Space {
     /// derivative methods ask (not the intensity estimator, nor the
     /// displaced scenes of finite differences).
     edge_tables: OnceLock<EdgeTables>,
+    /// A camera sensor's frame, and the moving edges each pixel sees (built
+    /// on first use, by the derivative methods).
+    pub(super) camera: Option<CameraFrame>,
+    pixel_edges: OnceLock<PixelEdges>,
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
     pub(super) pole_rules: Vec<PoleRule>,
@@ -137,6 +142,10 @@ impl Space {
                 *i -= 1;
             }
         }
+        let camera = match scene.sensor() {
+            SceneSensor::Camera(c) => Some(c.frame()),
+            _ => None,
+        };
         Space {
             caster: TriangleBvh::new(tris.clone()),
             opaque: TriangleBvh::new(opaque_tris),
@@ -148,6 +157,8 @@ impl Space {
             emitters,
             emitter_area,
             edge_tables: OnceLock::new(),
+            camera,
+            pixel_edges: OnceLock::new(),
             pole_rules,
             slot_field,
         }
@@ -168,6 +179,22 @@ impl Space {
     pub(super) fn edge_tables(&self) -> &EdgeTables {
         self.edge_tables
             .get_or_init(|| EdgeTables::new(&self.scene, &self.normals))
+    }
+
+    /// The moving meshes' edges each camera pixel sees, built on first use
+    /// (empty without a camera).
+    #[inline]
+    pub(super) fn pixel_edges(&self) -> &PixelEdges {
+        self.pixel_edges.get_or_init(|| match &self.camera {
+            None => PixelEdges::default(),
+            Some(cam) => {
+                let t = self.edge_tables();
+                let params = self.scene.parameters().len();
+                let moving = |k: u32| (0..params).any(|j| self.scene.parameter_shape(j) == k);
+                let ids = (0..t.edges.len() as u32).filter(|&i| moving(t.edges[i as usize].shape));
+                PixelEdges::new(cam, &t.edges, &t.edge_facts, ids, 1e-9 * self.scene.size())
+            }
+        })
     }
 
     /// Total area of the emitters.
@@ -282,7 +309,19 @@ impl Geometry for Space {
         match self.scene.sensor() {
             SceneSensor::Radiance { point, direction } => Sensor::Radiance { point, direction },
             SceneSensor::Irradiance { point, normal } => Sensor::Irradiance { point, normal },
+            SceneSensor::Camera(c) => Sensor::Camera { point: c.position },
         }
+    }
+    fn pixel_lobe(&self, s: PixelSample) -> Option<SpaceLobe> {
+        let cam = self.camera.as_ref()?;
+        Some(SpaceLobe::Pixel {
+            frame: [cam.f, cam.r, cam.u],
+            rect: cam.rect(s),
+            pixel: s.pixel,
+        })
+    }
+    fn image(&self) -> Option<(u32, u32)> {
+        self.camera.map(|c| (c.width, c.height))
     }
     #[inline]
     fn sensor_medium(&self) -> MediumId {

@@ -30,6 +30,7 @@
 //! nearly on one, `α` is large: one of the method's heavy tails). One field
 //! per pole rule ([`PoleRule`]), each with its own knot search. Book: chapter "Three dimensions",
 //! section "A warp on the sphere".
+use super::lobe::SpaceLobe;
 use super::space::Space;
 use crate::path::NO_PRIM;
 use crate::path::walk::Vertex;
@@ -170,15 +171,45 @@ impl Space {
             fields: [blank; MAX_FIELDS],
             count: self.pole_rules.len(),
         };
+        if let SpaceLobe::Pixel { frame, rect, pixel } = v.lobe {
+            // At a camera, one family for every slot: the image's rows
+            // (pole on the camera's right axis) or its columns (pole up),
+            // whichever the pixel's moving edges cross more steeply (a
+            // crossing slides along its fibre at v_n / sin of the angle
+            // between edge and fibre). The stratum's sides across the
+            // fibres are the ends; the other two are fibres. See
+            // `super::camera`.
+            let (mut across_rows, mut across_columns) = (0.0, 0.0);
+            for c in self.pixel_edges().of(pixel) {
+                across_rows += (c.b[1] - c.a[1]).abs();
+                across_columns += (c.b[0] - c.a[0]).abs();
+            }
+            let [f, r, u] = frame;
+            let (pole, ends) = if across_rows >= across_columns {
+                (r, [u.cross(f + r * rect[0]), u.cross(f + r * rect[1])])
+            } else {
+                (u, [r.cross(f + u * rect[2]), r.cross(f + u * rect[3])])
+            };
+            warp.count = 1;
+            warp.fields[0] = self.fibre_field(v, w, pole, ends);
+            return warp;
+        }
+        // A cosine lobe ends at its horizon.
+        let ends = match v.lobe {
+            SpaceLobe::Cosine { n, .. } => [n, DVec3::ZERO],
+            _ => [DVec3::ZERO; 2],
+        };
         for (f, rule) in warp.fields.iter_mut().zip(&self.pole_rules) {
-            *f = self.fibre_field(v, w, rule.at(v.x));
+            *f = self.fibre_field(v, w, rule.at(v.x), ends);
         }
         warp
     }
 
     // ANCHOR: fibre_warp
-    /// The field of the fibres from the pole `p` at `v` around `w`.
-    fn fibre_field(&self, v: &Vertex<Self>, w: DVec3, p: DVec3) -> FibreField {
+    /// The field of the fibres from the pole `p` at `v` around `w`; the
+    /// lobe ends on the great circles of normals `ends` (zero: none), where
+    /// the field moves with the frame.
+    fn fibre_field(&self, v: &Vertex<Self>, w: DVec3, p: DVec3, ends: [DVec3; 2]) -> FibreField {
         let x = v.x;
         let c = w.dot(p).clamp(-1.0, 1.0);
         let perp = w - p * c;
@@ -201,7 +232,7 @@ impl Space {
         // the frame): the horizon meets the fibre's great circle at ±(n × m),
         // the fibre at the one on its side (u·h > 0).
         let (mut lo, mut hi) = (still(1.0), still(-1.0));
-        if let crate::mesh::lobe::SpaceLobe::Cosine { n, .. } = v.lobe {
+        for n in ends {
             let h = n.cross(m);
             let len = h.length();
             if len > 1e-12 {

@@ -9,17 +9,47 @@ use super::expectation::Expectation;
 use super::rendering::Rendering;
 use super::transport::Transport;
 use super::walk::{Frame, Hooks, Vertex, walk};
-use super::{Boundaries, Geometry, Lobe, NO_PRIM, Sensor};
+use super::{Boundaries, Geometry, Lobe, NO_PRIM, PixelSample, Sensor, Vector};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
-use crate::stats::ChunkSums;
+use crate::stats::{ChunkSums, StratumSums};
 
-/// A reading of the sensor by one path: its weight, and the factor (the
-/// sensor lobe's weight) every derivative weight is multiplied by.
+/// A reading of the sensor by one path (a camera's: through `pixel`): its
+/// weight, and the factor (the sensor lobe's weight) every derivative
+/// weight is multiplied by.
 #[inline]
-pub fn reading<G: Geometry, H: Hooks<G>>(g: &G, hooks: &mut H, rng: &mut PathRng) -> (f64, f64) {
+pub fn reading<G: Geometry, H: Hooks<G>>(
+    g: &G,
+    hooks: &mut H,
+    rng: &mut PathRng,
+    pixel: PixelSample,
+) -> (f64, f64) {
     let medium = g.sensor_medium();
     match g.sensor() {
+        Sensor::Camera { point } => {
+            let Some(lobe) = g.pixel_lobe(pixel) else {
+                return (0.0, 0.0);
+            };
+            // No connection: a pinhole's lobe is a direction density, and
+            // the lamp's side cannot aim through the pinhole. A lamp seen
+            // directly counts whole (`drawn` = None).
+            let v = Vertex {
+                x: point,
+                medium,
+                skip: NO_PRIM,
+                lobe,
+                w_in: G::V::ZERO,
+                frame: Frame::Sensor,
+                beta: 1.0,
+                at_sensor: true,
+            };
+            let w = hooks.scatter(g, rng, &v);
+            let scale = lobe.weight();
+            (
+                scale * walk(g, hooks, rng, point, w, medium, NO_PRIM, 1.0, None),
+                scale,
+            )
+        }
         Sensor::Radiance { point, direction } => (
             walk(g, hooks, rng, point, direction, medium, NO_PRIM, 1.0, None),
             1.0,
@@ -82,7 +112,13 @@ pub struct DerivativeEstimator<G> {
 impl<G: Boundaries> DerivativeEstimator<G> {
     /// One path's weights, states from `scratch`.
     #[inline]
-    fn path(&self, rng: &mut PathRng, scratch: &mut Scratch<G::V>, out: &mut [f64]) {
+    fn path(
+        &self,
+        rng: &mut PathRng,
+        scratch: &mut Scratch<G::V>,
+        out: &mut [f64],
+        pixel: PixelSample,
+    ) {
         let g = &self.geometry;
         let slots = &self.slots;
         let mut d = scratch.take(slots.len());
@@ -95,15 +131,15 @@ impl<G: Boundaries> DerivativeEstimator<G> {
                     d,
                     frozen: false,
                 };
-                (reading(g, &mut h, rng), h.d)
+                (reading(g, &mut h, rng, pixel), h.d)
             }
             Scheme::Expectation => {
                 let mut h = Expectation { slots, scratch, d };
-                (reading(g, &mut h, rng), h.d)
+                (reading(g, &mut h, rng, pixel), h.d)
             }
             Scheme::Transport => {
                 let mut h = Transport::new(slots, scratch, d);
-                (reading(g, &mut h, rng), h.d)
+                (reading(g, &mut h, rng, pixel), h.d)
             }
         };
         out[0] = i;
@@ -131,16 +167,34 @@ impl<G: Boundaries> Estimator for DerivativeEstimator<G> {
         self.caveats.clone()
     }
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        self.path(rng, &mut Scratch::default(), weights);
+        self.path(
+            rng,
+            &mut Scratch::default(),
+            weights,
+            PixelSample::default(),
+        );
     }
     fn accumulate(&self, rng: &mut PathRng, paths: u64, sums: &mut [ChunkSums]) {
         let mut w = vec![0.0; sums.len()];
         let mut scratch = Scratch::default();
         for _ in 0..paths {
-            self.path(rng, &mut scratch, &mut w);
+            self.path(rng, &mut scratch, &mut w, PixelSample::default());
             for (s, &x) in sums.iter_mut().zip(&w) {
                 s.push(x);
             }
         }
+    }
+    fn image(&self) -> Option<(u32, u32)> {
+        self.geometry.image()
+    }
+    fn sample_pixel(&self, rng: &mut PathRng, pixel: PixelSample, weights: &mut [f64]) {
+        self.path(rng, &mut Scratch::default(), weights, pixel);
+    }
+    fn accumulate_pixel(&self, rng: &mut PathRng, pixel: u32, spp: u64, sums: &mut [StratumSums]) {
+        let mut w = vec![0.0; sums.len()];
+        let mut scratch = Scratch::default();
+        crate::estimator::stratified(pixel, spp, sums, &mut w, |s, w| {
+            self.path(rng, &mut scratch, w, s)
+        });
     }
 }

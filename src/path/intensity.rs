@@ -4,7 +4,7 @@
 //! "Flatland", section "Backward path tracing".
 use super::estimator::reading;
 use super::walk::Hooks;
-use super::{Geometry, MediumId, Prim};
+use super::{Geometry, MediumId, PixelSample, Prim};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
 
@@ -23,7 +23,14 @@ impl<G: Geometry> Estimator for IntensityEstimator<G> {
     }
     #[inline]
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        weights[0] = reading(&self.geometry, &mut (), rng).0;
+        weights[0] = reading(&self.geometry, &mut (), rng, PixelSample::default()).0;
+    }
+    fn image(&self) -> Option<(u32, u32)> {
+        self.geometry.image()
+    }
+    #[inline]
+    fn sample_pixel(&self, rng: &mut PathRng, pixel: PixelSample, weights: &mut [f64]) {
+        weights[0] = reading(&self.geometry, &mut (), rng, pixel).0;
     }
 }
 
@@ -51,7 +58,7 @@ impl<G: Geometry> Estimator for PlainEstimator<G> {
     }
     #[inline]
     fn sample(&self, rng: &mut PathRng, weights: &mut [f64]) {
-        weights[0] = reading(&self.geometry, &mut Plain, rng).0;
+        weights[0] = reading(&self.geometry, &mut Plain, rng, PixelSample::default()).0;
     }
 }
 

@@ -175,6 +175,27 @@ pub enum Sensor<V> {
         /// Unit normal.
         normal: V,
     },
+    /// A pinhole camera at `point`: a reading is one pixel's mean radiance
+    /// over its footprint ([`Geometry::pixel_lobe`]), so it needs a
+    /// [`PixelSample`].
+    Camera {
+        /// The pinhole.
+        point: V,
+    },
+}
+
+/// Where in a camera's image one path starts: pixel `pixel` (row-major,
+/// row 0 at the top), and stratum `stratum` of the `strata × strata` grid
+/// that splits its footprint (the path's direction is uniform in it).
+/// Ignored by the other sensors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PixelSample {
+    /// Pixel index, `row × width + column`.
+    pub pixel: u32,
+    /// Stratum index in `0..strata²`, row-major.
+    pub stratum: u32,
+    /// Strata per side (1: the whole footprint).
+    pub strata: u32,
 }
 
 /// A primitive (segment, triangle) index; [`NO_PRIM`] for none.
@@ -222,6 +243,18 @@ pub trait Geometry: Sync {
     fn size(&self) -> f64;
     /// What the sensor measures, and where.
     fn sensor(&self) -> Sensor<Self::V>;
+    /// For a camera: the lobe over directions of the footprint of `s`'s
+    /// stratum, `p(ω)` uniform over that part of the image plane (as a
+    /// density over directions), value = density, so a path's reading is
+    /// the stratum's mean radiance. `None` where the geometry has no camera.
+    fn pixel_lobe(&self, s: PixelSample) -> Option<Self::Lobe> {
+        let _ = s;
+        None
+    }
+    /// For a camera: its image's `(width, height)` in pixels.
+    fn image(&self) -> Option<(u32, u32)> {
+        None
+    }
     /// The medium around the sensor.
     fn sensor_medium(&self) -> MediumId;
     /// The closest primitive along the unit ray, other than `skip`.
@@ -290,10 +323,18 @@ pub enum Side {
 /// Where the integrand over directions jumps, and the warp that follows
 /// those jumps: the discontinuity machinery of a geometry.
 pub trait Boundaries: Geometry {
-    /// Draws one boundary point for the directional integral at `x`:
+    /// Draws one boundary point for the directional integral at `v`:
     /// among all of them when the vertex or its frame moves (`all`), else
-    /// among those of moving shapes.
-    fn sample_boundary(&self, x: Self::V, all: bool, u: f64) -> Option<BoundaryPoint<Self::V>>;
+    /// among those of moving shapes; at a camera, among those inside the
+    /// stratum's footprint (where `v`'s lobe is not 0).
+    fn sample_boundary(
+        &self,
+        v: &walk::Vertex<Self>,
+        all: bool,
+        u: f64,
+    ) -> Option<BoundaryPoint<Self::V>>
+    where
+        Self: Sized;
     /// What rays just to either side of the direction from `x` to the
     /// boundary point see there: first the side
     /// [`Boundaries::boundary_normal`] points to (plane: counter-clockwise),

@@ -156,7 +156,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     if !all && frozen {
         return;
     }
-    let Some(b) = g.sample_boundary(v.x, all, rng.random()) else {
+    let Some(b) = g.sample_boundary(v, all, rng.random()) else {
         return;
     };
     let r = b.q - v.x;

@@ -153,8 +153,9 @@ pub struct Parameter {
 }
 
 /// What is measured, at a static point. File form: `{ kind =
-/// "irradiance", point = [x, y, z], normal = [x, y, z] }` or `{ kind =
-/// "radiance", point = [x, y, z], direction = [x, y, z] }`.
+/// "irradiance", point = [x, y, z], normal = [x, y, z] }`, `{ kind =
+/// "radiance", point = [x, y, z], direction = [x, y, z] }` or `{ kind =
+/// "camera", position, look_at, up, fov_deg, width, height }`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(from = "repr::Sensor", into = "repr::Sensor")]
 pub enum Sensor {
@@ -173,13 +174,16 @@ pub enum Sensor {
         /// Normal (unit after validation).
         normal: DVec3,
     },
+    /// A pinhole camera: an image of pixel means (`geosens render`).
+    Camera(crate::mesh::camera::Camera),
 }
 
 impl Sensor {
-    /// The sensor's point.
+    /// The sensor's point (a camera's pinhole).
     pub fn point(&self) -> DVec3 {
         match *self {
             Sensor::Radiance { point, .. } | Sensor::Irradiance { point, .. } => point,
+            Sensor::Camera(c) => c.position,
         }
     }
 }

@@ -26,6 +26,7 @@ macro_rules! fields {
     )*};
 }
 fields!(axis: DVec3, pivot: Option<DVec3>, point: DVec3, direction: DVec3, normal: DVec3);
+fields!(position: DVec3, look_at: DVec3, up: DVec3, fov_deg: f64, width: u32, height: u32);
 
 #[derive(Clone, Copy, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
@@ -92,6 +93,20 @@ pub enum Sensor {
         #[serde(deserialize_with = "normal")]
         normal: DVec3,
     },
+    Camera {
+        #[serde(deserialize_with = "position")]
+        position: DVec3,
+        #[serde(deserialize_with = "look_at")]
+        look_at: DVec3,
+        #[serde(deserialize_with = "up")]
+        up: DVec3,
+        #[serde(deserialize_with = "fov_deg")]
+        fov_deg: f64,
+        #[serde(deserialize_with = "width")]
+        width: u32,
+        #[serde(deserialize_with = "height")]
+        height: u32,
+    },
 }
 
 impl From<Sensor> for super::Sensor {
@@ -99,6 +114,21 @@ impl From<Sensor> for super::Sensor {
         match s {
             Sensor::Radiance { point, direction } => Self::Radiance { point, direction },
             Sensor::Irradiance { point, normal } => Self::Irradiance { point, normal },
+            Sensor::Camera {
+                position,
+                look_at,
+                up,
+                fov_deg,
+                width,
+                height,
+            } => Self::Camera(crate::mesh::camera::Camera {
+                position,
+                look_at,
+                up,
+                fov_deg,
+                width,
+                height,
+            }),
         }
     }
 }
@@ -108,6 +138,14 @@ impl From<super::Sensor> for Sensor {
         match s {
             super::Sensor::Radiance { point, direction } => Self::Radiance { point, direction },
             super::Sensor::Irradiance { point, normal } => Self::Irradiance { point, normal },
+            super::Sensor::Camera(c) => Self::Camera {
+                position: c.position,
+                look_at: c.look_at,
+                up: c.up,
+                fov_deg: c.fov_deg,
+                width: c.width,
+                height: c.height,
+            },
         }
     }
 }

@@ -468,6 +468,12 @@ fn check_sensor(
                 normal: unit("sensor normal", normal)?,
             }
         }
+        Sensor::Camera(c) => {
+            if let Some(why) = c.problem() {
+                return config(why);
+            }
+            Sensor::Camera(c)
+        }
     };
     let p = sensor.point();
     for s in shapes {
