@@ -54,6 +54,7 @@ pub mod fd;
 #[cfg(feature = "figures")]
 mod figures_common;
 pub mod flat;
+pub mod image_io;
 pub mod mesh;
 pub mod method;
 pub mod path;
