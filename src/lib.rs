@@ -55,6 +55,7 @@ pub mod fd;
 mod figures_common;
 pub mod flat;
 pub mod image;
+pub mod image_io;
 pub mod mesh;
 pub mod method;
 pub mod path;
