@@ -365,6 +365,13 @@ fn scene_command(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let cfg = args.run.config(1_000_000)?;
     let estimator = args.fd.estimator(args.method, problem, Some(&args.scene))?;
+    if estimator.image().is_some() {
+        return Err(Error::Config(format!(
+            "{}: the sensor is a camera: its images come from `geosens render`",
+            args.scene.display()
+        ))
+        .into());
+    }
     let result = run(estimator.as_ref(), &cfg)?;
     all_finite(&result)?;
     let caveats = estimator.caveats();

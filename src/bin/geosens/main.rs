@@ -9,6 +9,9 @@
 //!   `--method fd`, on both subcommands);
 //! - `geosens mesh --scene FILE --method M [--json]`: the same for a 3D
 //!   triangle-mesh scene file (gradient axes x, y, z);
+//! - `geosens render --scene FILE --method M --spp N --out DIR`: every pixel
+//!   of a 3D scene's camera, images of `I` and every `∂I/∂π` with their
+//!   error images, and one JSON line of the images' means;
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
 //!   and thick rods at a few probes and prints them beside the exact solution,
 //!   then every method on two 3D occluder scenes beside their closed forms,
@@ -54,6 +57,9 @@ enum Command {
     /// Estimate I and ∂I/∂π for every parameter of a 3D (triangle-mesh)
     /// scene file; `transport` also gives ∂I/∂x, ∂I/∂y, ∂I/∂z.
     Mesh(SceneArgs),
+    /// Render a 3D scene's camera: images of I and of every ∂I/∂π with their
+    /// standard-error images (EXR, .npy, PNG) and one JSON line.
+    Render(render::RenderArgs),
 }
 
 /// `geosens flat` and `geosens mesh`: a scene file, a method, a run.
@@ -271,6 +277,7 @@ fn exact_result(rod: &Rod, probe: &Probe) -> RunResult {
 
 mod commands;
 mod output;
+mod render;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -280,6 +287,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => commands::compare_command(args, &mut out),
         Command::Flat(args) => commands::flat_command(args, &mut out),
         Command::Mesh(args) => commands::mesh_command(args, &mut out),
+        Command::Render(args) => render::render_command(args, &mut out),
     };
     match result.and_then(|()| Ok(out.flush()?)) {
         Ok(()) => ExitCode::SUCCESS,

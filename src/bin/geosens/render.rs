@@ -1,0 +1,211 @@
+//! `geosens render`: every pixel of a camera scene's image, for `I` and for
+//! every parameter's sensitivity, with their standard-error images; float
+//! images (OpenEXR, `.npy`), PNGs (a perceptual map for `I` and the error
+//! images, a diverging map centred on 0 for each sensitivity, the scale in
+//! the file name), and one JSON line whose means are the images' mean
+//! pixel values.
+use super::output::{MeanErr, caveat_of};
+use super::*;
+use geosens::image::{ImageResult, render};
+use geosens::image_io::{
+    Plane, robust_scale, scale_tag, write_exr, write_npy, write_png_diverging, write_png_magnitude,
+};
+use std::path::{Path, PathBuf};
+
+/// `geosens render`: a camera scene, a method, paths per pixel, a folder.
+#[derive(Debug, Args)]
+pub(super) struct RenderArgs {
+    /// 3D scene file with `[sensor] kind = "camera"`.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Estimation method.
+    #[arg(long, value_enum)]
+    method: Method,
+    /// Paths per pixel, at least 2.
+    #[arg(long, default_value_t = 64, allow_hyphen_values = true)]
+    spp: u64,
+    /// Folder the images go to (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// The finite differences' half step.
+    #[command(flatten)]
+    fd: FdArgs,
+    /// Seed of the random streams.
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
+    seed: u64,
+    /// Worker threads, 0 = all cores (images do not depend on it).
+    #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
+    threads: usize,
+}
+
+/// The JSON line of `geosens render`.
+#[derive(Serialize)]
+struct RenderJsonLine<'a> {
+    method: &'a str,
+    #[serde(rename = "I")]
+    intensity: MeanErr,
+    sensitivity: serde_json::Map<String, serde_json::Value>,
+    width: u32,
+    height: u32,
+    paths: u64,
+    seconds: f64,
+}
+
+/// A parameter name as a file name: letters, digits, `-` and `_` kept,
+/// anything else `_`.
+fn file_name(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Writes the images of `result` into `dir`; returns the files written.
+fn write_images(result: &ImageResult, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| Error::Output(format!("cannot create {}: {e}", dir.display())))?;
+    let (w, h) = (result.width as usize, result.height as usize);
+    let mut written = Vec::new();
+    for (q, img) in &result.images {
+        let stem = match q {
+            Quantity::Intensity => "I".to_owned(),
+            Quantity::Sensitivity(p) => format!("d_{}", file_name(p)),
+            Quantity::Gradient(a) => format!("grad_{}", file_name(a)),
+        };
+        let mean: Vec<f64> = img.iter().map(|e| e.mean).collect();
+        let stderr: Vec<f64> = img.iter().map(|e| e.stderr).collect();
+        for (name, data) in [(stem.clone(), &mean), (format!("{stem}_stderr"), &stderr)] {
+            let plane = Plane {
+                width: w,
+                height: h,
+                data,
+            };
+            for ext in ["exr", "npy"] {
+                let path = dir.join(format!("{name}.{ext}"));
+                if ext == "exr" {
+                    write_exr(&path, &plane)?;
+                } else {
+                    write_npy(&path, &plane)?;
+                }
+                written.push(path);
+            }
+        }
+        // The sensitivity on a diverging map (±scale), I and the error
+        // images on a perceptual one (0 to scale); the scale in the name.
+        let scale = robust_scale(&mean);
+        let png = |name: String| dir.join(name);
+        let main = if matches!(q, Quantity::Intensity) {
+            let path = png(format!("{stem}_max{}.png", scale_tag(scale)));
+            let plane = Plane {
+                width: w,
+                height: h,
+                data: &mean,
+            };
+            write_png_magnitude(&path, &plane, scale)?;
+            path
+        } else {
+            let path = png(format!("{stem}_pm{}.png", scale_tag(scale)));
+            let plane = Plane {
+                width: w,
+                height: h,
+                data: &mean,
+            };
+            write_png_diverging(&path, &plane, scale)?;
+            path
+        };
+        written.push(main);
+        let err_scale = robust_scale(&stderr);
+        let path = png(format!("{stem}_stderr_max{}.png", scale_tag(err_scale)));
+        let plane = Plane {
+            width: w,
+            height: h,
+            data: &stderr,
+        };
+        write_png_magnitude(&path, &plane, err_scale)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// `geosens render`.
+pub(super) fn render_command(
+    args: &RenderArgs,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
+    if args.threads > MAX_THREADS {
+        return Err(Error::Config(format!(
+            "threads = {}: expected 0 (all cores) to {MAX_THREADS}",
+            args.threads
+        ))
+        .into());
+    }
+    let scene = std::sync::Arc::new(geosens::mesh::file::load(&args.scene)?);
+    let estimator = args.fd.estimator(args.method, scene, Some(&args.scene))?;
+    let rows = estimator.image().map_or(0, |(_, h)| h);
+    let bar = indicatif::ProgressBar::new(u64::from(rows));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")
+            .map_err(|e| Error::Output(e.to_string()))?
+            .progress_chars("=> "),
+    );
+    bar.set_message(format!("render {}", estimator.method()));
+    let result = render(
+        estimator.as_ref(),
+        args.spp,
+        args.seed,
+        args.threads,
+        &|done| bar.set_position(done),
+    );
+    bar.finish_and_clear();
+    let result = result?;
+    let caveats = estimator.caveats();
+    for (q, why) in &caveats {
+        eprintln!("warning: {q}: {why}");
+    }
+    for (q, img) in &result.images {
+        if img
+            .iter()
+            .any(|e| !e.mean.is_finite() || !e.stderr.is_finite())
+        {
+            eprintln!("warning: {q}: some pixels are not finite (overflow)");
+        }
+    }
+    let written = write_images(&result, &args.out)?;
+    eprintln!(
+        "wrote {} files to {} ({}×{} pixels, {} paths per pixel, {:.2} s)",
+        written.len(),
+        args.out.display(),
+        result.width,
+        result.height,
+        result.spp,
+        result.seconds
+    );
+    let mut intensity = None;
+    let mut sensitivity = serde_json::Map::new();
+    for ((q, _), e) in result.images.iter().zip(&result.means) {
+        let m = MeanErr::of(e, caveat_of(&caveats, q));
+        match q {
+            Quantity::Intensity => intensity = Some(m),
+            Quantity::Sensitivity(p) => {
+                sensitivity.insert(p.clone(), serde_json::to_value(m)?);
+            }
+            Quantity::Gradient(_) => {}
+        }
+    }
+    let line = RenderJsonLine {
+        method: result.method,
+        intensity: intensity.ok_or("no intensity image")?,
+        sensitivity,
+        width: result.width,
+        height: result.height,
+        paths: result.paths(),
+        seconds: result.seconds,
+    };
+    writeln!(out, "{}", serde_json::to_string(&line)?)?;
+    Ok(())
+}

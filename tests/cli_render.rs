@@ -1,0 +1,213 @@
+//! `geosens render`: its JSON line, the files it writes (EXR, .npy, PNG,
+//! error images) and what they hold, bit-identical images for any thread
+//! count, and clear errors.
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn geosens(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_geosens"))
+        .args(args)
+        .output()
+        .expect("the geosens binary runs")
+}
+
+fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/mesh")
+        .join(name)
+        .to_str()
+        .unwrap()
+        .to_owned()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir =
+        std::env::temp_dir().join(format!("geosens-cli-render-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn render(method: &str, dir: &Path, extra: &[&str]) -> Value {
+    let s = scene("camera_shadow.toml");
+    let d = dir.to_str().unwrap();
+    let mut args = vec![
+        "render", "--scene", &s, "--method", method, "--spp", "32", "--out", d,
+    ];
+    args.extend_from_slice(extra);
+    let out = geosens(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{method} failed: {stderr}");
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(stdout.lines().count(), 1, "not one line: {stdout}");
+    serde_json::from_str(&stdout).unwrap()
+}
+
+/// The `.npy` file's float64 values (the header parsed as numpy writes it).
+fn npy(path: &Path) -> (Vec<usize>, Vec<f64>) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..6], b"\x93NUMPY");
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    assert!(header.contains("'descr': '<f8'"), "{header}");
+    let shape = header
+        .split("'shape': (")
+        .nth(1)
+        .unwrap()
+        .split(')')
+        .next()
+        .unwrap();
+    let shape: Vec<usize> = shape
+        .split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| s.trim().parse().unwrap())
+        .collect();
+    let data = bytes[10 + header_len..]
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    (shape, data)
+}
+
+#[test]
+fn render_writes_every_image_and_its_mean() {
+    let dir = scratch("rendering");
+    let line = render("rendering", &dir, &[]);
+    assert_eq!(line["method"], "rendering");
+    assert_eq!(
+        (line["width"].as_u64(), line["height"].as_u64()),
+        (Some(32), Some(32))
+    );
+    assert_eq!(line["paths"].as_u64(), Some(32 * 32 * 32));
+    assert!(line["seconds"].as_f64().unwrap() > 0.0);
+    let names = ["tri_tx", "tri_tz", "tri_rot"];
+    let files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    for stem in ["I".to_owned()]
+        .into_iter()
+        .chain(names.iter().map(|n| format!("d_{n}")))
+    {
+        for f in [
+            format!("{stem}.exr"),
+            format!("{stem}.npy"),
+            format!("{stem}_stderr.exr"),
+            format!("{stem}_stderr.npy"),
+        ] {
+            assert!(files.contains(&f), "{f} missing in {files:?}");
+        }
+        let pngs = files
+            .iter()
+            .filter(|f| f.starts_with(&stem) && f.ends_with(".png"))
+            .count();
+        assert_eq!(pngs, 2, "{stem}: one image and one error PNG, with scales");
+        // The JSON mean is the image's mean pixel value, its error bar
+        // that of a mean of independent pixels.
+        let (shape, img) = npy(&dir.join(format!("{stem}.npy")));
+        let (_, err) = npy(&dir.join(format!("{stem}_stderr.npy")));
+        assert_eq!(shape, vec![32, 32]);
+        let mean = img.iter().sum::<f64>() / img.len() as f64;
+        let se = err.iter().map(|e| e * e).sum::<f64>().sqrt() / err.len() as f64;
+        let entry = if stem == "I" {
+            &line["I"]
+        } else {
+            &line["sensitivity"][&stem[2..]]
+        };
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (a.abs() + b.abs());
+        assert!(
+            close(entry["mean"].as_f64().unwrap(), mean),
+            "{stem}: {entry} vs {mean}"
+        );
+        assert!(
+            close(entry["stderr"].as_f64().unwrap(), se),
+            "{stem}: {entry} vs {se}"
+        );
+    }
+    assert!(
+        files
+            .iter()
+            .any(|f| f.starts_with("d_tri_tx_pm") && f.ends_with(".png"))
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn images_do_not_depend_on_the_thread_count() {
+    let (a, b) = (scratch("t1"), scratch("t2"));
+    let one = render("expectation", &a, &["--threads", "1", "--seed", "9"]);
+    let two = render("expectation", &b, &["--threads", "2", "--seed", "9"]);
+    assert_eq!(one["I"], two["I"]);
+    assert_eq!(one["sensitivity"], two["sensitivity"]);
+    for f in ["I.npy", "d_tri_tx.npy", "d_tri_rot_stderr.npy"] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&a);
+    let _ = std::fs::remove_dir_all(&b);
+}
+
+#[test]
+fn bad_requests_are_refused_with_a_message() {
+    let dir = scratch("bad");
+    let d = dir.to_str().unwrap();
+    let probe = scene("triangle.toml");
+    let camera = scene("camera_shadow.toml");
+    for (args, says) in [
+        (
+            vec![
+                "render",
+                "--scene",
+                &probe,
+                "--method",
+                "rendering",
+                "--out",
+                d,
+            ],
+            "not a camera",
+        ),
+        (
+            vec![
+                "render",
+                "--scene",
+                &camera,
+                "--method",
+                "rendering",
+                "--spp",
+                "1",
+                "--out",
+                d,
+            ],
+            "spp",
+        ),
+        (
+            vec!["mesh", "--scene", &camera, "--method", "intensity"],
+            "geosens render",
+        ),
+    ] {
+        let out = geosens(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+    // A file where the folder should be.
+    let file = std::env::temp_dir().join(format!("geosens-cli-render-{}-file", std::process::id()));
+    std::fs::write(&file, b"x").unwrap();
+    let f = file.to_str().unwrap();
+    let out = geosens(&[
+        "render",
+        "--scene",
+        &camera,
+        "--method",
+        "intensity",
+        "--out",
+        f,
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains(f), "{stderr}");
+    let _ = std::fs::remove_file(&file);
+}
