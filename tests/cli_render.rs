@@ -193,6 +193,27 @@ fn bad_requests_are_refused_with_a_message() {
         assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
+    // Cameras that cannot be: each named.
+    let text = std::fs::read_to_string(&camera).unwrap();
+    for (from, to, says) in [
+        ("fov_deg = 90.0", "fov_deg = 180.0", "fov_deg"),
+        ("width = 32", "width = 0", "width"),
+        ("up = [0.0, 1.0, 0.0]", "up = [0.0, 0.0, 1.0]", "up"),
+        ("width = 32", "width = 32\nzoom = 2", "zoom"),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let bad = std::env::temp_dir().join(format!(
+            "geosens-cli-render-{}-{says}.toml",
+            std::process::id()
+        ));
+        std::fs::write(&bad, text.replace(from, to)).unwrap();
+        let b = bad.to_str().unwrap();
+        let out = geosens(&["render", "--scene", b, "--method", "intensity", "--out", d]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{to}: {stderr}");
+        assert!(stderr.contains(says), "{to}: {stderr}");
+        let _ = std::fs::remove_file(&bad);
+    }
     // A file where the folder should be.
     let file = std::env::temp_dir().join(format!("geosens-cli-render-{}-file", std::process::id()));
     std::fs::write(&file, b"x").unwrap();
