@@ -102,12 +102,18 @@ pub fn write_npy(path: &Path, plane: &Plane) -> Result<(), Error> {
 /// [magenta](NON_FINITE_RGB). A `max` ≤ 0 or not finite is "no range": every
 /// finite pixel takes the low colour.
 pub fn write_png_magnitude(path: &Path, plane: &Plane, max: f64) -> Result<(), Error> {
+    write_png(path, plane, magnitude_map(max))
+}
+
+/// The colour of a finite value in [`write_png_magnitude`]'s map (viridis
+/// from 0 to `max`), for drawing such images elsewhere (the book's figures).
+pub fn magnitude_map(max: f64) -> impl Fn(f64) -> [u8; 3] {
     let ranged = max.is_finite() && max > 0.0;
-    write_png(path, plane, |x| {
+    move |x| {
         let t = if ranged { x / max } else { 0.0 };
         let c = colorous::VIRIDIS.eval_continuous(t.clamp(0.0, 1.0));
         [c.r, c.g, c.b]
-    })
+    }
 }
 
 /// Writes `plane` as an 8-bit RGB PNG in the diverging map red–blue
@@ -120,19 +126,25 @@ pub fn write_png_magnitude(path: &Path, plane: &Plane, max: f64) -> Result<(), E
 /// NaN and ±∞ are [magenta](NON_FINITE_RGB). A `scale` ≤ 0 or not finite is
 /// "no range": every finite pixel takes the middle colour.
 pub fn write_png_diverging(path: &Path, plane: &Plane, scale: f64) -> Result<(), Error> {
+    write_png(path, plane, diverging_map(scale))
+}
+
+/// The colour of a finite value in [`write_png_diverging`]'s map (red–blue
+/// over `±scale`), for drawing such images elsewhere (the book's figures).
+pub fn diverging_map(scale: f64) -> impl Fn(f64) -> [u8; 3] {
     let ranged = scale.is_finite() && scale > 0.0;
     // Stop k of 0..=10 runs from blue (k = 0, negative) to red (k = 10).
     let stops: Vec<[f64; 3]> = (0..11)
         .map(|k| colorous::RED_BLUE.eval_rational(10 - k, 11))
         .map(|c| [c.r, c.g, c.b].map(f64::from))
         .collect();
-    write_png(path, plane, |x| {
+    move |x| {
         let t = if ranged { 0.5 + 0.5 * x / scale } else { 0.5 };
         let p = 10.0 * t.clamp(0.0, 1.0);
         let k = (p.floor() as usize).min(9);
         let (a, b, f) = (stops[k], stops[k + 1], p - k as f64);
         [0, 1, 2].map(|i| (a[i] + f * (b[i] - a[i])).round() as u8)
-    })
+    }
 }
 
 /// A display scale robust to a few outliers: the 99th percentile of `|x|`

@@ -8,7 +8,9 @@
 //! The scenes are built in code ([`crate::mesh::cases`]): a black triangle
 //! occluder under the unit-square lamp, whose `E` and `∂E/∂π` have closed
 //! forms ([`crate::mesh::exact`]), and the configurations where the methods
-//! struggle. Colours per method are flatland's ([`color`]).
+//! struggle. Colours per method are flatland's ([`color`]). The exception
+//! is [`camera`]: the showcase scene file's images, drawn pixel by pixel
+//! with plotters directly (PNG only).
 use super::Scene;
 use crate::error::Error;
 use crate::figures_common;
@@ -22,6 +24,7 @@ pub use crate::flat::figures::{DERIVATIVE_METHODS, METHODS, REFERENCE_COLOR, col
 pub use crate::rod::figures::{FigureFn, FigureOptions};
 
 pub mod against_pi;
+pub mod camera;
 pub mod convergence;
 pub mod efficiency;
 pub mod stability;
@@ -35,6 +38,7 @@ pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             convergence::convergence,
             efficiency::efficiency,
             stability::stability,
+            camera::camera,
         ],
     )
 }

@@ -49,6 +49,16 @@ impl FigureOptions {
     /// `out/figures` and 1), and a runner that prints the files `figure`
     /// writes: what every `examples/fig_*.rs` does.
     pub fn run_example(figure: FigureFn) -> Result<(), Error> {
+        let opts = FigureOptions::from_args()?;
+        for path in figure(&opts)? {
+            println!("wrote {}", path.display());
+        }
+        Ok(())
+    }
+
+    /// Options from an example's command line, `[OUT_DIR] [EFFORT]`
+    /// (defaults `out/figures` and 1).
+    pub fn from_args() -> Result<FigureOptions, Error> {
         let mut args = std::env::args().skip(1);
         let mut opts = FigureOptions::new(args.next().unwrap_or_else(|| "out/figures".into()));
         if let Some(e) = args.next() {
@@ -58,10 +68,7 @@ impl FigureOptions {
                 .filter(|v: &f64| v.is_finite() && *v > 0.0)
                 .ok_or_else(|| Error::Output(format!("bad effort {e:?}: expected a number > 0")))?;
         }
-        for path in figure(&opts)? {
-            println!("wrote {}", path.display());
-        }
-        Ok(())
+        Ok(opts)
     }
 
     /// `paths` scaled by the effort, at least 2.
