@@ -35,12 +35,27 @@ impl Boundaries for Plane {
     #[inline]
     /// A corner drawn with probability proportional to its weight (a binary
     /// search in the cumulative weights).
-    fn sample_boundary(
-        &self,
-        _v: &Vertex<Self>,
-        all: bool,
-        u: f64,
-    ) -> Option<BoundaryPoint<DVec2>> {
+    fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec2>> {
+        if let FlatLobe::Pixel { x0, x1, .. } = v.lobe {
+            // A camera stands still: the moving corners seen through the
+            // stratum, drawn uniformly.
+            debug_assert!(!all, "a camera does not move");
+            let list = self.camera_corner_list();
+            let lo = list.partition_point(|c| c.0 < x0);
+            let hi = list.partition_point(|c| c.0 <= x1);
+            if hi <= lo {
+                return None;
+            }
+            let n = hi - lo;
+            let index = list[lo + ((u * n as f64) as usize).min(n - 1)].1;
+            let (q, shape) = self.scene.corners()[index as usize];
+            return Some(BoundaryPoint {
+                q,
+                shape,
+                index,
+                inv_pdf: n as f64,
+            });
+        }
         let cdf = if all { &self.all_cdf } else { &self.moving_cdf };
         let total = *cdf.last()?;
         if total <= 0.0 {
@@ -433,7 +448,12 @@ pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
             }
             (point, FlatLobe::Cosine { n: normal, c: 1.0 }, true)
         }
-        FlatSensor::Radiance { point, direction } => (
+        FlatSensor::Radiance { point, direction }
+        | FlatSensor::Camera {
+            position: point,
+            direction,
+            ..
+        } => (
             point,
             FlatLobe::Phase {
                 phase: Phase::Isotropic,

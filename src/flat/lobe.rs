@@ -30,6 +30,35 @@ pub enum FlatLobe {
         /// Incoming direction.
         w_in: DVec2,
     },
+    /// A line camera's pixel stratum: `p(ω) = |ξ|² / (x1 − x0)` for the
+    /// directions through `ξ = f + x r`, `x ∈ [x0, x1]` on the image line at
+    /// unit distance (`dθ = dx / |ξ|²`), 0 elsewhere; value = density.
+    Pixel {
+        /// View axis.
+        f: DVec2,
+        /// The image line's direction (clockwise from `f`).
+        r: DVec2,
+        /// The stratum's footprint on the image line.
+        x0: f64,
+        /// See `x0`.
+        x1: f64,
+        /// The pixel (its corners for the boundary term).
+        pixel: u32,
+    },
+}
+
+/// The density of a line camera's pixel lobe at `w`.
+#[inline]
+fn pixel_density(f: DVec2, r: DVec2, x0: f64, x1: f64, w: DVec2) -> f64 {
+    let c = w.dot(f);
+    if c <= 0.0 {
+        return 0.0;
+    }
+    let x = w.dot(r) / c;
+    if x < x0 || x > x1 {
+        return 0.0;
+    }
+    1.0 / (c * c * (x1 - x0))
 }
 
 /// The phase function at the cosine `c` of the scattering angle.
@@ -79,6 +108,7 @@ impl Lobe<DVec2> for FlatLobe {
         match *self {
             FlatLobe::Cosine { n, c } => c * w.dot(n).max(0.0),
             FlatLobe::Phase { phase, w_in } => phase_value(phase, w.dot(w_in)),
+            FlatLobe::Pixel { f, r, x0, x1, .. } => pixel_density(f, r, x0, x1, w),
         }
     }
     #[inline]
@@ -86,13 +116,14 @@ impl Lobe<DVec2> for FlatLobe {
         match *self {
             FlatLobe::Cosine { n, .. } => 0.5 * w.dot(n).max(0.0),
             FlatLobe::Phase { phase, w_in } => phase_value(phase, w.dot(w_in)),
+            FlatLobe::Pixel { f, r, x0, x1, .. } => pixel_density(f, r, x0, x1, w),
         }
     }
     #[inline]
     fn weight(&self) -> f64 {
         match *self {
             FlatLobe::Cosine { c, .. } => 2.0 * c,
-            FlatLobe::Phase { .. } => 1.0,
+            FlatLobe::Phase { .. } | FlatLobe::Pixel { .. } => 1.0,
         }
     }
     #[inline]
@@ -100,6 +131,10 @@ impl Lobe<DVec2> for FlatLobe {
         match *self {
             FlatLobe::Cosine { n, .. } => cosine_direction(n, rng),
             FlatLobe::Phase { phase, w_in } => phase_direction(phase, w_in, rng),
+            // Uniform on the footprint.
+            FlatLobe::Pixel { f, r, x0, x1, .. } => {
+                (f + r * (x0 + (x1 - x0) * rng.random::<f64>())).normalize()
+            }
         }
     }
     #[inline]
@@ -107,6 +142,8 @@ impl Lobe<DVec2> for FlatLobe {
         match *self {
             FlatLobe::Cosine { n, .. } => wd.dot(n) / w.dot(n),
             FlatLobe::Phase { phase, w_in } => phase_dlog_dcos(phase, w.dot(w_in)) * wd.dot(w_in),
+            // ln p = −2 ln(ω·f) + const inside the footprint.
+            FlatLobe::Pixel { f, .. } => -2.0 * wd.dot(f) / w.dot(f),
         }
     }
 }
@@ -126,6 +163,14 @@ impl FlatLobe {
             // The whole circle: a knot found one way is found the other way
             // too, and none found means no corner at all.
             FlatLobe::Phase { .. } => (TAU, TAU),
+            // The footprint's ends: x grows clockwise.
+            FlatLobe::Pixel { f, r, x0, x1, .. } => {
+                let angle = |x: f64| {
+                    let e = f + r * x;
+                    cross(w, e).atan2(w.dot(e))
+                };
+                (angle(x0).max(0.0), (-angle(x1)).max(0.0))
+            }
         }
     }
 }

@@ -92,7 +92,10 @@ pub(crate) fn check_expectation_g(kind: &str, name: &str, g: f64) -> Result<(), 
 
 /// The derivative estimator of `scheme` on `scene`.
 pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plane> {
-    let gradient = scheme == Scheme::Transport;
+    // The sensor position's gradient at a probe; a camera's images are of
+    // the parameters only.
+    let camera = matches!(scene.sensor(), super::Sensor::Camera { .. });
+    let gradient = scheme == Scheme::Transport && !camera;
     let mut names: Vec<Quantity> = scene
         .parameters()
         .iter()
@@ -216,13 +219,13 @@ fn round4(x: f64) -> f64 {
 }
 
 /// What the sensor sees, up to continuous motion: the corners visible from
-/// an irradiance sensor in front of it, in angular order; the shape a
-/// radiance sensor's ray meets first.
+/// an irradiance sensor or a camera in front of it, in angular order; the
+/// shape a radiance sensor's ray meets first.
 fn sensor_view(scene: &Scene) -> Vec<u32> {
     use super::Sensor;
     use super::geometry::NO_SEGMENT;
     match scene.sensor() {
-        Sensor::Irradiance { .. } => super::space::sensor_corners(scene)
+        Sensor::Irradiance { .. } | Sensor::Camera { .. } => super::space::sensor_corners(scene)
             .into_iter()
             .map(|(_, i)| i as u32)
             .collect(),

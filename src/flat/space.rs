@@ -7,7 +7,7 @@
 use super::geometry::{NO_SEGMENT, cross};
 use super::lobe::FlatLobe;
 use super::scene::{Phase, Scene, Sensor as FlatSensor};
-use crate::path::{Geometry, Hit, MediumId, Prim, Sensor, Surface};
+use crate::path::{Geometry, Hit, MediumId, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec2;
 use rand::RngExt;
@@ -35,6 +35,35 @@ pub struct Plane {
     /// angle from +x: the warp's knots there, the same for every path
     /// (found on first use: only the expectation method asks).
     sensor_knots: OnceLock<Vec<Knot>>,
+    /// A line camera's corners (see [`Plane::camera_corner_list`]).
+    camera_corners: OnceLock<Vec<(f64, u32)>>,
+}
+
+/// A line camera's frame: view axis `f`, image line direction `r`
+/// (clockwise from `f`), half-width `half` of the image line at unit
+/// distance, `width` pixels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineCamera {
+    /// View axis.
+    pub f: DVec2,
+    /// Image line direction (pixel 0 at `x = −half`).
+    pub r: DVec2,
+    /// `tan(fov / 2)`.
+    pub half: f64,
+    /// Pixels.
+    pub width: u32,
+}
+
+impl LineCamera {
+    /// The footprint `[x0, x1]` on the image line of the stratum of `s`
+    /// (a pixel's `strata²` equal parts).
+    pub fn rect(&self, s: PixelSample) -> (f64, f64) {
+        let d = 2.0 * self.half / f64::from(self.width);
+        let parts = f64::from(s.strata.max(1)).powi(2);
+        let e = d / parts;
+        let x0 = -self.half + d * f64::from(s.pixel) + e * f64::from(s.stratum);
+        (x0, x0 + e)
+    }
 }
 
 /// A knot of the warp: angle from the sampled direction, corner, shape.
@@ -104,12 +133,56 @@ impl Plane {
             all_cdf,
             moving_cdf,
             sensor_knots: OnceLock::new(),
+            camera_corners: OnceLock::new(),
         }
     }
 
     /// The scene.
     pub fn scene(&self) -> &Arc<Scene> {
         &self.scene
+    }
+
+    /// The line camera's frame, if the sensor is one.
+    pub(super) fn line_camera(&self) -> Option<LineCamera> {
+        match self.scene.sensor() {
+            FlatSensor::Camera {
+                direction,
+                fov_deg,
+                width,
+                ..
+            } => Some(LineCamera {
+                f: direction,
+                r: DVec2::new(direction.y, -direction.x),
+                half: (0.5 * fov_deg.to_radians()).tan(),
+                width,
+            }),
+            _ => None,
+        }
+    }
+
+    /// The moving shapes' corners in front of a line camera that can be
+    /// discontinuities (weight > 0), by their place on its image line:
+    /// `(x, corner)`, sorted (built on first use).
+    pub(super) fn camera_corner_list(&self) -> &[(f64, u32)] {
+        self.camera_corners.get_or_init(|| {
+            let Some(cam) = self.line_camera() else {
+                return Vec::new();
+            };
+            let eye = self.scene.sensor().point();
+            let corners = self.scene.corners();
+            let mut list: Vec<(f64, u32)> = self
+                .moving_corners
+                .iter()
+                .filter(|&&i| self.corner_weight[i as usize] > 0.0)
+                .filter_map(|&i| {
+                    let r = corners[i as usize].0 - eye;
+                    let z = r.dot(cam.f);
+                    (z > 0.0).then(|| (r.dot(cam.r) / z, i))
+                })
+                .collect();
+            list.sort_by(|a, b| a.0.total_cmp(&b.0));
+            list
+        })
     }
 
     /// The warp's knots at an irradiance sensor (see the field).
@@ -124,11 +197,18 @@ impl Plane {
     }
 }
 
-/// The corners an irradiance sensor sees in front of it, by angle from +x:
-/// `(angle, index into scene.corners())`; none for a radiance sensor.
+/// The corners an irradiance sensor (or a camera) sees in front of it, by
+/// angle from +x: `(angle, index into scene.corners())`; none for a
+/// radiance sensor.
 pub(super) fn sensor_corners(scene: &Scene) -> Vec<(f64, usize)> {
-    let FlatSensor::Irradiance { point, normal } = scene.sensor() else {
-        return Vec::new();
+    let (point, normal) = match scene.sensor() {
+        FlatSensor::Irradiance { point, normal } => (point, normal),
+        FlatSensor::Camera {
+            position,
+            direction,
+            ..
+        } => (position, direction),
+        FlatSensor::Radiance { .. } => return Vec::new(),
     };
     let mut seen: Vec<(f64, usize)> = scene
         .corners()
@@ -158,7 +238,22 @@ impl Geometry for Plane {
         match self.scene.sensor() {
             FlatSensor::Radiance { point, direction } => Sensor::Radiance { point, direction },
             FlatSensor::Irradiance { point, normal } => Sensor::Irradiance { point, normal },
+            FlatSensor::Camera { position, .. } => Sensor::Camera { point: position },
         }
+    }
+    fn pixel_lobe(&self, s: PixelSample) -> Option<FlatLobe> {
+        let cam = self.line_camera()?;
+        let (x0, x1) = cam.rect(s);
+        Some(FlatLobe::Pixel {
+            f: cam.f,
+            r: cam.r,
+            x0,
+            x1,
+            pixel: s.pixel,
+        })
+    }
+    fn image(&self) -> Option<(u32, u32)> {
+        self.line_camera().map(|c| (c.width, 1))
     }
     #[inline]
     fn sensor_medium(&self) -> MediumId {

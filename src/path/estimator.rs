@@ -41,7 +41,9 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
                 w_in: G::V::ZERO,
                 frame: Frame::Sensor,
                 beta: 1.0,
-                at_sensor: true,
+                // Its warp knots are searched like any vertex's (flatland
+                // precomputes them for the irradiance sensor only).
+                at_sensor: false,
             };
             let w = hooks.scatter(g, rng, &v);
             let scale = lobe.weight();

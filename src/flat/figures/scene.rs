@@ -216,7 +216,12 @@ pub const ALL_SURFACES: [Surface; 4] = [
 pub fn sensor(scene: &Scene, r: f64, label: &str) -> Series {
     let (x, n) = match scene.sensor() {
         Sensor::Irradiance { point, normal } => (point, normal),
-        Sensor::Radiance { point, direction } => (point, direction),
+        Sensor::Radiance { point, direction }
+        | Sensor::Camera {
+            position: point,
+            direction,
+            ..
+        } => (point, direction),
     };
     let t = perp(n);
     let v: Vec<(f64, f64)> = match scene.sensor() {
@@ -226,7 +231,7 @@ pub fn sensor(scene: &Scene, r: f64, label: &str) -> Series {
                 xy(x + r * (a.cos() * t + a.sin() * n))
             })
             .collect(),
-        Sensor::Radiance { .. } => vec![
+        Sensor::Radiance { .. } | Sensor::Camera { .. } => vec![
             xy(x + 0.6 * r * t),
             xy(x + 2.0 * r * n),
             xy(x - 0.6 * r * t),
@@ -280,7 +285,9 @@ pub fn sample_paths(scene: &Scene, seed: u64) -> Vec<PathRecord> {
     (0..PATHS)
         .map(|_| {
             let (w, factor) = match scene.sensor() {
-                Sensor::Radiance { direction, .. } => (direction, 1.0),
+                Sensor::Radiance { direction, .. } | Sensor::Camera { direction, .. } => {
+                    (direction, 1.0)
+                }
                 Sensor::Irradiance { normal, .. } => (cosine_direction(normal, &mut rng), 2.0),
             };
             let mut vertices = vec![[x.x, x.y]];

@@ -77,7 +77,8 @@ fn frame(scene: &Scene) -> (DVec2, f64) {
     let x = scene.sensor().point();
     let phi_n = match scene.sensor() {
         crate::flat::Sensor::Irradiance { normal, .. } => normal.y.atan2(normal.x),
-        crate::flat::Sensor::Radiance { direction, .. } => direction.y.atan2(direction.x),
+        crate::flat::Sensor::Radiance { direction, .. }
+        | crate::flat::Sensor::Camera { direction, .. } => direction.y.atan2(direction.x),
     };
     (x, phi_n)
 }

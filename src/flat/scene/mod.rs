@@ -189,13 +189,32 @@ pub enum Sensor {
         #[serde(deserialize_with = "repr::normal")]
         normal: DVec2,
     },
+    /// A line camera (`geosens::image::render`): `width` pixels across the
+    /// field of view `fov_deg` about `direction`, pixel 0 on the left
+    /// (counter-clockwise side) as one looks along `direction`; each pixel
+    /// is the mean radiance over its footprint on the image line.
+    Camera {
+        /// The pinhole.
+        #[serde(deserialize_with = "repr::position")]
+        position: DVec2,
+        /// View axis (normalised on construction).
+        #[serde(deserialize_with = "repr::direction")]
+        direction: DVec2,
+        /// Field of view in degrees, in `(0, 170]`.
+        #[serde(deserialize_with = "repr::fov_deg")]
+        fov_deg: f64,
+        /// Pixels, 1 to 8192.
+        #[serde(deserialize_with = "repr::width")]
+        width: u32,
+    },
 }
 
 impl Sensor {
-    /// The sensor's point.
+    /// The sensor's point (a camera's pinhole).
     pub fn point(&self) -> DVec2 {
         match *self {
             Sensor::Radiance { point, .. } | Sensor::Irradiance { point, .. } => point,
+            Sensor::Camera { position, .. } => position,
         }
     }
 }

@@ -26,7 +26,7 @@ macro_rules! fields {
     )*};
 }
 fields!(radiance: f64, albedo: f64, g: f64, pivot: Option<DVec2>,
-    point: DVec2, direction: DVec2, normal: DVec2);
+    point: DVec2, direction: DVec2, normal: DVec2, position: DVec2, fov_deg: f64, width: u32);
 
 #[derive(Clone, Copy, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]

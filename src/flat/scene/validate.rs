@@ -385,6 +385,32 @@ fn check_sensor(
                 normal: unit("sensor normal", normal)?,
             }
         }
+        Sensor::Camera {
+            position,
+            direction,
+            fov_deg,
+            width,
+        } => {
+            finite("camera position", position)?;
+            if !(fov_deg > 0.0 && fov_deg <= 170.0) {
+                return config(format!(
+                    "camera fov_deg = {}: expected a field of view in (0, 170]",
+                    Num(fov_deg)
+                ));
+            }
+            if width == 0 || width > crate::mesh::camera::MAX_SIDE {
+                return config(format!(
+                    "camera width = {width}: expected 1 to {} pixels",
+                    crate::mesh::camera::MAX_SIDE
+                ));
+            }
+            Sensor::Camera {
+                position,
+                direction: unit("camera direction", direction)?,
+                fov_deg,
+                width,
+            }
+        }
     };
     let p = sensor.point();
     for (i, seg) in segments.iter().enumerate() {
