@@ -26,7 +26,7 @@
 # MAX_DEPTH defaults to 8 (Mitsuba counts the camera segment: 8 = up to 7
 # bounces), rr_depth 5 as geosens's Russian roulette after 5 bounces.
 #
-# Measured 2026-11-25 on 2 shared cores, `16 8 GEOSENS_OUT`: I agrees with
+# Measured 2026-11-24 on 2 shared cores, `16 8 GEOSENS_OUT`: I agrees with
 # geosens (0.082339 +- 0.000015 vs 0.082342 +- 0.000005; correlation 0.999
 # as is, flips worse). Forward renders take ~20 s each at 16 spp (a fixed
 # cost: guiding-octree construction, proj_seed_spp = 512), 30 s the first.
