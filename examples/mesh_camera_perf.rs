@@ -19,7 +19,7 @@
 //!
 //! Caveat: at the pilot's spp most pixels of a derivative image are noise,
 //! which inflates `mean_p |v_p|`: the pilot's `rel` is too low and its
-//! prediction too small (showcase_nofog, 2026-11-25: pilot 0.79 at 16 spp
+//! prediction too small (showcase_nofog, 2026-11-24: pilot 0.79 at 16 spp
 //! predicted 4015 spp; 2331 spp measured 11 % and 24 %). The final
 //! extrapolation, from a `rel` of 10–30 %, is the number to use.
 //!

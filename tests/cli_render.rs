@@ -232,3 +232,38 @@ fn bad_requests_are_refused_with_a_message() {
     assert!(stderr.contains(f), "{stderr}");
     let _ = std::fs::remove_file(&file);
 }
+
+/// A flatland scene with a line camera renders through the same command: a
+/// row of pixels.
+#[test]
+fn flatland_line_cameras_render_a_row() {
+    let dir = scratch("flat");
+    let s = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/camera_line.toml")
+        .to_str()
+        .unwrap()
+        .to_owned();
+    let d = dir.to_str().unwrap();
+    let out = geosens(&[
+        "render",
+        "--scene",
+        &s,
+        "--method",
+        "transport",
+        "--spp",
+        "64",
+        "--out",
+        d,
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let line: Value = serde_json::from_str(&String::from_utf8(out.stdout).unwrap()).unwrap();
+    assert_eq!(
+        (line["width"].as_u64(), line["height"].as_u64()),
+        (Some(40), Some(1))
+    );
+    assert!(line["sensitivity"]["tx"]["mean"].is_f64());
+    let (shape, _) = npy(&dir.join("d_rot.npy"));
+    assert_eq!(shape, vec![1, 40]);
+    let _ = std::fs::remove_dir_all(&dir);
+}

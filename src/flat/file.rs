@@ -69,6 +69,32 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
     parse_file(path, from_toml, from_json)
 }
 
+/// The dimension of the scene file at `path`: 2 if its sensor's point
+/// (`point` or `position`) has two coordinates (a flatland file), else 3
+/// (the 3D loader then says what is wrong). Errors only if the file cannot
+/// be read or parsed at all.
+pub fn dimension(path: &Path) -> Result<usize, Error> {
+    fn as_json(text: &str) -> Result<serde_json::Value, Error> {
+        let value: toml::Value =
+            toml::from_str(text).map_err(|e| Error::Scene(e.message().to_owned()))?;
+        serde_json::to_value(value).map_err(|e| Error::Scene(e.to_string()))
+    }
+    fn from_json_text(text: &str) -> Result<serde_json::Value, Error> {
+        serde_json::from_str(text).map_err(|e| json_error(text, &e))
+    }
+    let value = parse_file(path, as_json, from_json_text)?;
+    let sensor = &value["sensor"];
+    let point = if sensor["point"].is_array() {
+        &sensor["point"]
+    } else {
+        &sensor["position"]
+    };
+    Ok(match point.as_array() {
+        Some(a) if a.len() == 2 => 2,
+        _ => 3,
+    })
+}
+
 /// `e` with the file `path` named in its message (scene errors only).
 pub(crate) fn in_file(path: &Path, e: Error) -> Error {
     match e {

@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 /// `geosens render`: a camera scene, a method, paths per pixel, a folder.
 #[derive(Debug, Args)]
 pub(super) struct RenderArgs {
-    /// 3D scene file with `[sensor] kind = "camera"`.
+    /// Scene file (3D, or flatland for a line camera) with `[sensor] kind =
+    /// "camera"`.
     #[arg(long)]
     scene: PathBuf,
     /// Estimation method.
@@ -144,8 +145,14 @@ pub(super) fn render_command(
         ))
         .into());
     }
-    let scene = std::sync::Arc::new(geosens::mesh::file::load(&args.scene)?);
-    let estimator = args.fd.estimator(args.method, scene, Some(&args.scene))?;
+    let path = Some(args.scene.as_path());
+    let estimator = if geosens::flat::file::dimension(&args.scene)? == 2 {
+        let scene = std::sync::Arc::new(geosens::flat::file::load(&args.scene)?);
+        args.fd.estimator(args.method, scene, path)?
+    } else {
+        let scene = std::sync::Arc::new(geosens::mesh::file::load(&args.scene)?);
+        args.fd.estimator(args.method, scene, path)?
+    };
     let rows = estimator.image().map_or(0, |(_, h)| h);
     let bar = indicatif::ProgressBar::new(u64::from(rows));
     bar.set_style(
