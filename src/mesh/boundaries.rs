@@ -7,10 +7,11 @@
 //! The boundary term of the directional integral is a line integral along
 //! those arcs, `∮ f (L_behind − L_ahead) v_n dl`. An edge is drawn from the
 //! edge hierarchy ([`super::edges`]: by weight, length × dihedral turn / π,
-//! among the edges that can be discontinuities from `x`), a point uniformly
-//! in angle along its arc (the same uniform number, rescaled), and the
-//! inverse density per unit arc length, `Γ / p(e)` for an arc of angle `Γ`,
-//! goes into the boundary point, so the path core's corner term
+//! among the edges that can be discontinuities from `x`), a point in angle
+//! along its arc (the same uniform number, rescaled): half the time
+//! uniformly, half the time on the parts of the arc behind which a lamp
+//! lies; the inverse of the mixture's density per unit arc length goes into
+//! the boundary point, so the path core's corner term
 //! (`rendering::corner_jump`) is, unchanged, the edge term.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
 use super::lobe::SpaceLobe;
@@ -41,7 +42,61 @@ impl Space {
     }
 }
 
+/// Most emitter triangles for which the edge points are also drawn where a
+/// lamp lies behind them (a test per emitter triangle per draw).
+const LAMP_TRIANGLES: usize = 16;
+
 impl Space {
+    /// The parts of an edge's arc seen from `x` (in the plane of unit normal
+    /// `n`, angles `α ∈ [0, arc]` from `wa` toward `t`) behind which an
+    /// emitter triangle lies: per triangle, the angles of the segment where
+    /// the plane cuts it, clipped to the arc. `None` without such parts, or
+    /// with more than [`LAMP_TRIANGLES`] emitter triangles.
+    #[allow(clippy::type_complexity)]
+    fn lamp_intervals(
+        &self,
+        x: DVec3,
+        n: DVec3,
+        wa: DVec3,
+        t: DVec3,
+        arc: f64,
+    ) -> Option<([(f64, f64); LAMP_TRIANGLES], usize, f64)> {
+        if self.emitters.is_empty() || self.emitters.len() > LAMP_TRIANGLES {
+            return None;
+        }
+        let mut out = [(0.0, 0.0); LAMP_TRIANGLES];
+        let (mut count, mut total) = (0, 0.0);
+        for &(prim, _) in &self.emitters {
+            let tri = self.tris[prim as usize];
+            let h = tri.map(|v| (v - x).dot(n));
+            // Where the plane cuts the triangle's sides.
+            let mut angles = [0.0f64; 2];
+            let mut k = 0;
+            for i in 0..3 {
+                let (a, b) = (i, (i + 1) % 3);
+                if (h[a] > 0.0) != (h[b] > 0.0) && k < 2 {
+                    let s = h[a] / (h[a] - h[b]);
+                    let r = tri[a] + (tri[b] - tri[a]) * s - x;
+                    angles[k] = r.dot(t).atan2(r.dot(wa));
+                    k += 1;
+                }
+            }
+            if k < 2 {
+                continue;
+            }
+            let (lo, hi) = (
+                angles[0].min(angles[1]).max(0.0),
+                angles[0].max(angles[1]).min(arc),
+            );
+            if hi > lo {
+                out[count] = (lo, hi);
+                count += 1;
+                total += hi - lo;
+            }
+        }
+        (count > 0 && total > 0.0).then_some((out, count, total))
+    }
+
     /// A point on the moving edges seen through the footprint `rect` of
     /// camera pixel `pixel` from the pinhole `x`: uniform in image-plane
     /// length, `inv_pdf` per unit arc length on the sphere (the image
@@ -82,7 +137,8 @@ impl Space {
 impl Boundaries for Space {
     // ANCHOR: sample_boundary
     /// An edge drawn from the edge hierarchy (by weight among those that
-    /// can be discontinuities seen from `x`), a point uniformly along it;
+    /// can be discontinuities seen from `x`), a point along its arc (uniform
+    /// in angle, or on the parts with a lamp behind: a mixture of the two);
     /// `inv_pdf` is per unit arc length on the sphere seen from `x`.
     #[inline]
     fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
@@ -120,7 +176,36 @@ impl Boundaries for Space {
         let n = n / sin_g;
         let wa = ra.normalize();
         let t = n.cross(wa);
-        let (s, c) = (along * arc).sin_cos();
+        // Half the draws uniform in angle, half on the parts of the arc
+        // behind which a lamp lies (where the jump carries direct light):
+        // the density is the mixture's, whichever strategy drew the point.
+        let lamps = self.lamp_intervals(x, n, wa, t, arc);
+        let (alpha, density) = match lamps {
+            None => (along * arc, 1.0 / arc),
+            Some((ref intervals, count, total)) => {
+                let alpha = if along < 0.5 {
+                    2.0 * along * arc
+                } else {
+                    let mut left = (2.0 * along - 1.0) * total;
+                    let mut pick = intervals[count - 1];
+                    for iv in &intervals[..count] {
+                        let len = iv.1 - iv.0;
+                        if left < len {
+                            pick = *iv;
+                            break;
+                        }
+                        left -= len;
+                    }
+                    (pick.0 + left.min(pick.1 - pick.0)).clamp(0.0, arc)
+                };
+                let inside = intervals[..count]
+                    .iter()
+                    .filter(|iv| iv.0 <= alpha && alpha <= iv.1)
+                    .count() as f64;
+                (alpha, 0.5 / arc + 0.5 * inside / total)
+            }
+        };
+        let (s, c) = alpha.sin_cos();
         let w = wa * c + t * s;
         // Where the ray along w meets the edge's line, in the plane (x, a, b).
         let d = edge.b - edge.a;
@@ -133,7 +218,7 @@ impl Boundaries for Space {
             q,
             shape: edge.shape,
             index,
-            inv_pdf: arc / p,
+            inv_pdf: 1.0 / (p * density),
         })
     }
     // ANCHOR_END: sample_boundary

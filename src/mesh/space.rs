@@ -49,7 +49,7 @@ pub struct Space {
     opaque: TriangleBvh,
     opaque_index: Vec<u32>,
     /// Emitting triangles with their cumulative area, and the total.
-    emitters: Vec<(Prim, f64)>,
+    pub(super) emitters: Vec<(Prim, f64)>,
     emitter_area: f64,
     /// The edges and their hierarchies, built on first use: only the
     /// derivative methods ask (not the intensity estimator, nor the
