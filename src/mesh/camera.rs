@@ -61,13 +61,14 @@ impl Camera {
         if f.length() <= 0.0 {
             return Some("camera look_at equals its position".into());
         }
-        if f.normalize().cross(self.up).length() < 1e-6 || self.up.length() == 0.0 {
+        let up = self.up.normalize_or_zero();
+        if up == DVec3::ZERO || f.normalize().cross(up).length() < 1e-6 {
             return Some("camera up is zero or along the view axis".into());
         }
         if !(self.fov_deg > 0.0 && self.fov_deg <= 170.0) {
             return Some(format!(
                 "camera fov_deg = {}: expected a horizontal field of view in (0, 170]",
-                self.fov_deg
+                crate::error::Num(self.fov_deg)
             ));
         }
         for (name, n) in [("width", self.width), ("height", self.height)] {

@@ -339,9 +339,29 @@ pub(super) fn flat_command(
     args: &SceneArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
+    check_dimension(&args.scene, 2)?;
     let scene = std::sync::Arc::new(geosens::flat::file::load(&args.scene)?);
     let (shapes, parameters) = (scene.shapes().len(), scene.parameters().len());
     scene_command(args, scene, shapes, parameters, out)
+}
+
+/// Errors if the scene file at `path` is of the other dimension than
+/// `want` (its sensor's point tells): the loader's own message would be
+/// about a field, not the subcommand.
+fn check_dimension(path: &std::path::Path, want: usize) -> Result<(), Error> {
+    let got = geosens::flat::file::dimension(path)?;
+    if got == want {
+        return Ok(());
+    }
+    let (is, use_) = if got == 2 {
+        ("a flatland (2D) scene file", "geosens flat")
+    } else {
+        ("a 3D scene file", "geosens mesh")
+    };
+    Err(Error::Scene(format!(
+        "{}: this is {is} (its sensor's point has {got} coordinates): use `{use_}`",
+        path.display()
+    )))
 }
 
 /// `geosens mesh`.
@@ -349,6 +369,7 @@ pub(super) fn mesh_command(
     args: &SceneArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
+    check_dimension(&args.scene, 3)?;
     let scene = std::sync::Arc::new(geosens::mesh::file::load(&args.scene)?);
     let (shapes, parameters) = (scene.shapes().len(), scene.parameters().len());
     scene_command(args, scene, shapes, parameters, out)
