@@ -6,7 +6,7 @@ use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::flat::figures::{METHODS, color};
 use crate::method::{Method, Problem};
-use crate::plot::{Figure, Legend, Panel, Series, single_legend};
+use crate::plot::{Figure, Panel, Series};
 use crate::runner::RunResult;
 use crate::stats::Estimate;
 use serde::Serialize;
@@ -207,7 +207,7 @@ where
     } else {
         (1e-12, 1.0)
     };
-    let mut panels: Vec<Panel> = spec
+    let panels: Vec<Panel> = spec
         .scenes
         .iter()
         .zip(&groups)
@@ -220,8 +220,7 @@ where
             panel((spec.title)(name), g, &rs, floor, top)
         })
         .collect();
-    single_legend(&mut panels, &[Legend::UpperRight, Legend::UpperLeft]);
-    let mut figure = Figure::new(panels, 1);
+    let mut figure = Figure::new(panels, 1).share_legend();
     figure.panel_size = spec.panel_size;
     save(opts, spec.prefix, "efficiency", &figure, &records)
 }

@@ -28,7 +28,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 
 /// The scenes drawn, one panel each.
-pub const SCENES: [&str; 7] = [
+pub const SCENES: [&str; 9] = [
     "occluder",
     "polygon_occluder",
     "absorbing_slab",
@@ -36,6 +36,8 @@ pub const SCENES: [&str; 7] = [
     "reflector",
     "three_shapes",
     "radiance",
+    "submerged",
+    "camera_line",
 ];
 
 /// Paths drawn per scene.
@@ -446,9 +448,9 @@ fn panel(name: &str, scene: &Scene, seed: u64) -> (Panel, SceneRecord) {
 }
 
 /// The scenes drawn with their paths and boundary points, one panel per
-/// scene of [`SCENES`] (2 × 2). Writes `flat_scene.{png,svg}` and
+/// scene of [`SCENES`] (4 per row, the legend last). Writes `flat_scene.{png,svg}` and
 /// `flat_scene.json` (the paths, the hits and the corners). Samples only
-/// `4 × 20` paths: the effort does not change it.
+/// 20 paths per scene: the effort does not change it.
 pub fn scene(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let mut panels = Vec::new();
     let mut records = Vec::new();
