@@ -203,7 +203,9 @@ where
     let lo = works.clone().fold(f64::INFINITY, f64::min);
     let hi = works.fold(0.0f64, f64::max);
     let (floor, top) = if lo.is_finite() && hi > 0.0 {
-        (10f64.powf(lo.log10().floor()), hi * spec.headroom)
+        // A decade at least half a decade under the smallest bar, so that
+        // every bar shows its height.
+        (10f64.powf((lo.log10() - 0.5).floor()), hi * spec.headroom)
     } else {
         (1e-12, 1.0)
     };
