@@ -433,10 +433,12 @@ fn row_height(size: u32) -> i32 {
     (size as f64 * 1.5).round() as i32
 }
 
-/// The entries laid out in rows no wider than `width`: per row, each
-/// entry's index and x offset.
-fn legend_rows(entries: &[Entry], size: u32, width: i32) -> Vec<Vec<(usize, i32)>> {
-    let mut rows: Vec<Vec<(usize, i32)>> = Vec::new();
+/// Legend rows: per row, each entry's index and x offset in pixels.
+type Rows = Vec<Vec<(usize, i32)>>;
+
+/// The entries laid out in rows no wider than `width`.
+fn legend_rows(entries: &[Entry], size: u32, width: i32) -> Rows {
+    let mut rows: Rows = Vec::new();
     let mut x = 0;
     for (i, e) in entries.iter().enumerate() {
         let w = entry_width(e, size);
@@ -958,7 +960,7 @@ fn tick(v: f64, log: bool) -> String {
     } else if v.abs() < 1e-2 || v.abs() >= 1e4 {
         format!("{v:.1e}")
     } else {
-        format!("{v:.3}")
+        format!("{v:.4}")
             .trim_end_matches('0')
             .trim_end_matches('.')
             .to_string()
@@ -1010,7 +1012,7 @@ impl Figure {
     }
 
     /// The shared legend's entries and rows, and the strip's height.
-    fn legend_strip(&self) -> (Vec<Entry>, Vec<Vec<(usize, i32)>>, u32) {
+    fn legend_strip(&self) -> (Vec<Entry>, Rows, u32) {
         let list = entries(&self.legend);
         if list.is_empty() {
             return (list, Vec::new(), 0);

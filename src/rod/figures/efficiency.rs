@@ -65,7 +65,12 @@ fn work_panel(title: String, records: &[Record]) -> Panel {
             color,
             xy.iter().map(|&(x, w)| (x, w, 0.0)).collect(),
         ));
-        series.push(Series::line(&label, color, xy));
+        // Dashed as in the error panels, where it lies on rendering.
+        series.push(if method == Method::Transport {
+            Series::dashes(&label, color, xy)
+        } else {
+            Series::line(&label, color, xy)
+        });
     }
     Panel {
         title,
@@ -187,9 +192,14 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             error_vs_time,
         },
     )?;
-    let mut written = Figure::new(panels, 2)
-        .share_legend()
-        .save(&opts.out, "efficiency")?;
+    let mut figure = Figure::new(panels, 2).share_legend();
+    // The lines are σ and the dots the errors only in the bottom row.
+    for s in &mut figure.legend {
+        if s.label.ends_with("(lines)") || s.label.ends_with("(dots)") {
+            s.label.insert_str(s.label.len() - 1, ", bottom row");
+        }
+    }
+    let mut written = figure.save(&opts.out, "efficiency")?;
     written.push(json);
     Ok(written)
 }
