@@ -170,6 +170,9 @@ pub struct Panel {
     /// a larger font): a figure's shared legend in a panel of its own. The
     /// series should hold no data.
     pub legend_only: bool,
+    /// Font size of the tick labels instead of the default (crowded
+    /// categorical axes).
+    pub tick_size: Option<u32>,
     /// One unit takes as many pixels along x as along y (drawings of
     /// scenes): the shorter data range is widened about its centre to the
     /// chart's aspect. Linear axes only.
@@ -304,15 +307,15 @@ pub fn diverging(t: f64) -> RGBColor {
 /// Margin around every chart, in pixels.
 const MARGIN: u32 = 12;
 /// Height of the x axis' label area, in pixels.
-const X_LABEL_AREA: u32 = 48;
+const X_LABEL_AREA: u32 = 54;
 /// Width of the y axis' label area, in pixels.
-const Y_LABEL_AREA: u32 = 78;
+const Y_LABEL_AREA: u32 = 88;
 /// Font size of panel titles.
-const TITLE_SIZE: u32 = 18;
+const TITLE_SIZE: u32 = 20;
 /// Font size of tick labels and axis descriptions.
-const AXIS_SIZE: u32 = 14;
+const AXIS_SIZE: u32 = 16;
 /// Font size of legend entries.
-const LEGEND_SIZE: u32 = 16;
+const LEGEND_SIZE: u32 = 17;
 /// Font size of a figure's shared legend.
 const SHARED_LEGEND_SIZE: u32 = 20;
 /// Width of a legend entry's mark, in pixels.
@@ -745,7 +748,7 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
         .y_label_formatter(&fmt_y)
         .x_labels(label_count(&p.x_tick_names))
         .y_labels(label_count(&p.y_tick_names))
-        .label_style(("sans-serif", AXIS_SIZE))
+        .label_style(("sans-serif", p.tick_size.unwrap_or(AXIS_SIZE)))
         .axis_desc_style(("sans-serif", AXIS_SIZE))
         .light_line_style(WHITE.mix(0.0))
         .draw()

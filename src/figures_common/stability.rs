@@ -189,7 +189,7 @@ pub(crate) fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Re
     }
     Panel {
         title: if has_exact {
-            "bias: (mean − closed form)/σ, clamped to ±12; dashed ±4".into()
+            "bias (mean − exact)/σ, clamped ±12; dashed ±4".into()
         } else {
             "no closed form: the estimates, mean ± σ".into()
         },

@@ -110,6 +110,6 @@ pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             .map(|&(case, _, axis, ..)| bias_panel(case, axis, "∂E/∂π", &records)),
     );
     let mut figure = Figure::new(panels, 3).share_legend();
-    figure.panel_size = (620, 440);
+    figure.panel_size = (520, 420);
     save(opts, "stability", &figure, &records)
 }

@@ -108,6 +108,6 @@ pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             .map(|&(case, _, axis, _, _)| bias_panel(case, axis, "∂E/∂p", &records)),
     );
     let mut figure = Figure::new(panels, CASES.len()).share_legend();
-    figure.panel_size = (540, 440);
+    figure.panel_size = (480, 420);
     save(opts, "stability", &figure, &records)
 }

@@ -290,6 +290,7 @@ fn panel(cells: &[&Cell], thicknesses: &[f64], title: String) -> Panel {
         title,
         x_label: "x / length (non-uniform grid)".into(),
         x_tick_names: position_names(),
+        tick_size: Some(13),
         y_label: "optical thickness κe × length".into(),
         y_tick_names: thicknesses.iter().map(|&t| two_digits(t)).collect(),
         series: vec![
