@@ -9,6 +9,7 @@
 use crate::error::Error;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::{Path, PathBuf};
 
 /// What a series draws.
@@ -18,6 +19,9 @@ pub enum Mark {
     Line(Vec<(f64, f64)>),
     /// A dashed polyline through `(x, y)`.
     Dashed(Vec<(f64, f64)>),
+    /// A thick dashed polyline: a curve that may lie on another one, which
+    /// then shows through its gaps.
+    Dashes(Vec<(f64, f64)>),
     /// Points `(x, mean, σ)` with ±σ error bars.
     Points(Vec<(f64, f64, f64)>),
     /// A thin (1 px) polyline through `(x, y)`: many light lines, such as
@@ -47,6 +51,16 @@ pub struct Series {
 }
 
 impl Series {
+    /// A legend entry of dots without error bars (points drawn elsewhere
+    /// without a label, such as errors): a series that draws nothing.
+    pub fn legend_dot(label: &str, color: usize) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Points(vec![(f64::NAN, f64::NAN, 0.0)]),
+        }
+    }
+
     /// A line series.
     pub fn line(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
         Series {
@@ -62,6 +76,15 @@ impl Series {
             label: label.into(),
             color,
             mark: Mark::Dashed(xy),
+        }
+    }
+
+    /// A thick dashed line series (drawn over a line it may hide).
+    pub fn dashes(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Dashes(xy),
         }
     }
 
@@ -147,17 +170,25 @@ pub struct Panel {
     /// a larger font): a figure's shared legend in a panel of its own. The
     /// series should hold no data.
     pub legend_only: bool,
+    /// Font size of the tick labels instead of the default (crowded
+    /// categorical axes).
+    pub tick_size: Option<u32>,
     /// One unit takes as many pixels along x as along y (drawings of
     /// scenes): the shorter data range is widened about its centre to the
     /// chart's aspect. Linear axes only.
     pub equal_aspect: bool,
 }
 
-/// Legend placement inside a panel.
+/// Legend placement: a strip between a panel's title and its chart (the
+/// default), or a corner inside the chart. A corner is kept only if the
+/// legend's box, measured in pixels, covers no drawn point there; otherwise
+/// the legend goes above the chart, so that it never hides data.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Legend {
-    /// Upper right corner.
+    /// Above the chart, under the title, entries side by side in rows.
     #[default]
+    Above,
+    /// Upper right corner.
     UpperRight,
     /// Upper left corner.
     UpperLeft,
@@ -176,6 +207,10 @@ pub struct Figure {
     pub columns: usize,
     /// Size of one panel in pixels.
     pub panel_size: (u32, u32),
+    /// A legend shared by every panel, drawn as a strip across the top of
+    /// the figure (series without data: only their label, colour and
+    /// mark count); empty: none.
+    pub legend: Vec<Series>,
 }
 
 /// The palette: colour-blind-safe (Okabe–Ito).
@@ -207,6 +242,7 @@ fn bounds(p: &Panel) -> ((f64, f64), (f64, f64)) {
         match &s.mark {
             Mark::Line(v)
             | Mark::Dashed(v)
+            | Mark::Dashes(v)
             | Mark::Thin(v)
             | Mark::Circles(v)
             | Mark::Polygon { vertices: v, .. } => v.iter().for_each(|&(x, y)| {
@@ -271,29 +307,58 @@ pub fn diverging(t: f64) -> RGBColor {
 /// Margin around every chart, in pixels.
 const MARGIN: u32 = 12;
 /// Height of the x axis' label area, in pixels.
-const X_LABEL_AREA: u32 = 40;
+const X_LABEL_AREA: u32 = 54;
 /// Width of the y axis' label area, in pixels.
-const Y_LABEL_AREA: u32 = 70;
+const Y_LABEL_AREA: u32 = 88;
 /// Font size of panel titles.
-const TITLE_SIZE: u32 = 18;
+const TITLE_SIZE: u32 = 20;
+/// Font size of tick labels and axis descriptions.
+const AXIS_SIZE: u32 = 16;
+/// Font size of legend entries.
+const LEGEND_SIZE: u32 = 17;
+/// Font size of a figure's shared legend.
+const SHARED_LEGEND_SIZE: u32 = 20;
+/// Width of a legend entry's mark, in pixels.
+const GLYPH_W: i32 = 28;
+/// Gap between a legend mark and its text, and around a legend box.
+const LEGEND_PAD: i32 = 8;
+/// Gap between two entries of a legend row, in pixels.
+const ENTRY_GAP: i32 = 24;
+/// Distance of a corner legend from the chart's edges, in pixels.
+const LEGEND_INSET: i32 = 8;
+
+/// Height of a title's block (plotters draws a caption with half its
+/// height, at most 5 px, above and below).
+fn title_height(title: &str) -> u32 {
+    if title.is_empty() {
+        return 0;
+    }
+    let h = ("sans-serif", TITLE_SIZE)
+        .into_font()
+        .box_size(title)
+        .map_or(TITLE_SIZE, |(_, h)| h);
+    h + 2 * (h / 2).min(5)
+}
+
+/// The chart's plotting area, in pixels, in an area of size `(w, h)` with
+/// a caption `title` (plotters lays a chart out as margin, then title,
+/// then label areas; this repeats that arithmetic).
+fn plot_size((w, h): (u32, u32), title: &str, top_margin: u32) -> (f64, f64) {
+    let pw = f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1));
+    let ph = f64::from(
+        h.saturating_sub(MARGIN + top_margin + title_height(title) + X_LABEL_AREA)
+            .max(1),
+    );
+    (pw, ph)
+}
 
 /// `x` and `y` ranges widened so that one unit spans as many pixels along
-/// both axes of the chart `p` gets in `area` (plotters lays a chart out as
-/// margin, then title, then label areas; this repeats that arithmetic).
-fn equal_aspect<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    p: &Panel,
+/// both axes of a plotting area of `(pw, ph)` pixels.
+fn equal_aspect(
+    (pw, ph): (f64, f64),
     (x0, x1): (f64, f64),
     (y0, y1): (f64, f64),
 ) -> ((f64, f64), (f64, f64)) {
-    let (w, h) = area.dim_in_pixel();
-    let style = ("sans-serif", TITLE_SIZE).into_text_style(area);
-    let title_h = area
-        .estimate_text_size(&p.title, &style)
-        .map_or(TITLE_SIZE, |(_, th)| th);
-    let title = title_h + 2 * (title_h / 2).min(5);
-    let pw = f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1));
-    let ph = f64::from(h.saturating_sub(2 * MARGIN + title + X_LABEL_AREA).max(1));
     let unit = ((x1 - x0) / pw).max((y1 - y0) / ph);
     let widen = |lo: f64, hi: f64, px: f64| {
         let (c, half) = (0.5 * (lo + hi), 0.5 * unit * px);
@@ -307,11 +372,15 @@ fn equal_aspect<DB: DrawingBackend>(
 enum Glyph {
     /// A short line of this width.
     Line(u32),
+    /// A short dashed line of this width.
+    Dash(u32),
     /// A filled box of this opacity.
     Fill(f64),
     /// A hollow circle.
     Ring,
-    /// A dot.
+    /// A dot with an error bar: an estimate.
+    Estimate,
+    /// A dot: points without error bars.
     Dot,
 }
 
@@ -320,41 +389,370 @@ impl Glyph {
         match mark {
             Mark::Polygon { opacity, .. } => Glyph::Fill(opacity.max(0.3)),
             Mark::Circles(_) => Glyph::Ring,
-            Mark::Points(_) => Glyph::Dot,
+            Mark::Points(v) if !v.is_empty() && v.iter().all(|p| p.2 == 0.0) => Glyph::Dot,
+            Mark::Points(_) => Glyph::Estimate,
             Mark::Thin(_) => Glyph::Line(1),
-            _ => Glyph::Line(2),
+            Mark::Dashed(_) => Glyph::Dash(2),
+            Mark::Dashes(_) => Glyph::Dash(3),
+            Mark::Line(_) => Glyph::Line(3),
         }
     }
 }
 
-fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), Error> {
-    let ((mut x0, mut x1), (mut y0, mut y1)) = bounds(p);
-    if p.equal_aspect && !p.x_log && !p.y_log {
-        ((x0, x1), (y0, y1)) = equal_aspect(area, p, (x0, x1), (y0, y1));
+/// One legend entry.
+struct Entry {
+    label: String,
+    color: RGBColor,
+    glyph: Glyph,
+}
+
+/// The legend entries of `series`: one per label, in order.
+fn entries<'a>(series: impl IntoIterator<Item = &'a Series>) -> Vec<Entry> {
+    let mut out: Vec<Entry> = Vec::new();
+    for s in series {
+        if s.label.is_empty() || out.iter().any(|e| e.label == s.label) {
+            continue;
+        }
+        out.push(Entry {
+            label: s.label.clone(),
+            color: PALETTE[s.color % PALETTE.len()],
+            glyph: Glyph::of(&s.mark),
+        });
     }
-    let axes = if p.legend_only { 0 } else { 1 };
-    let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, ("sans-serif", TITLE_SIZE))
+    out
+}
+
+/// Width in pixels of `e` (mark, gap, text) in a font of `size`.
+fn entry_width(e: &Entry, size: u32) -> i32 {
+    let text = ("sans-serif", size)
+        .into_font()
+        .box_size(&e.label)
+        .map_or(size * e.label.chars().count() as u32 / 2, |(w, _)| w);
+    GLYPH_W + LEGEND_PAD + text as i32
+}
+
+/// Height of one legend row for a font of `size`.
+fn row_height(size: u32) -> i32 {
+    (size as f64 * 1.5).round() as i32
+}
+
+/// Legend rows: per row, each entry's index and x offset in pixels.
+type Rows = Vec<Vec<(usize, i32)>>;
+
+/// The entries laid out in rows no wider than `width`.
+fn legend_rows(entries: &[Entry], size: u32, width: i32) -> Rows {
+    let mut rows: Rows = Vec::new();
+    let mut x = 0;
+    for (i, e) in entries.iter().enumerate() {
+        let w = entry_width(e, size);
+        match rows.last_mut() {
+            Some(row) if x + w <= width => row.push((i, x)),
+            _ => {
+                rows.push(vec![(i, 0)]);
+                x = 0;
+            }
+        }
+        x += w + ENTRY_GAP;
+    }
+    rows
+}
+
+/// Draws `e`'s mark and label with the mark's left end at `(x, y)`
+/// (pixels of `area`; `y` is the row's middle).
+fn draw_entry<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+    e: &Entry,
+    size: u32,
+) -> Result<(), Error> {
+    let c = e.color;
+    let mid = x + GLYPH_W / 2;
+    match e.glyph {
+        Glyph::Line(w) => area.draw(&PathElement::new(
+            vec![(x, y), (x + GLYPH_W, y)],
+            c.stroke_width(w),
+        )),
+        Glyph::Dash(w) => area
+            .draw(&PathElement::new(
+                vec![(x, y), (x + 10, y)],
+                c.stroke_width(w),
+            ))
+            .and_then(|_| {
+                area.draw(&PathElement::new(
+                    vec![(x + 17, y), (x + GLYPH_W, y)],
+                    c.stroke_width(w),
+                ))
+            }),
+        Glyph::Fill(a) => area
+            .draw(&Rectangle::new(
+                [(x, y - 7), (x + GLYPH_W, y + 7)],
+                c.mix(a).filled(),
+            ))
+            .and_then(|_| {
+                area.draw(&Rectangle::new(
+                    [(x, y - 7), (x + GLYPH_W, y + 7)],
+                    c.stroke_width(1),
+                ))
+            }),
+        Glyph::Ring => area.draw(&Circle::new((mid, y), 6, c.stroke_width(2))),
+        Glyph::Estimate => area
+            .draw(&PathElement::new(
+                vec![(mid, y - 8), (mid, y + 8)],
+                c.stroke_width(1),
+            ))
+            .and_then(|_| {
+                area.draw(&PathElement::new(
+                    vec![(mid - 4, y - 8), (mid + 4, y - 8)],
+                    c.stroke_width(1),
+                ))
+            })
+            .and_then(|_| {
+                area.draw(&PathElement::new(
+                    vec![(mid - 4, y + 8), (mid + 4, y + 8)],
+                    c.stroke_width(1),
+                ))
+            })
+            .and_then(|_| area.draw(&Circle::new((mid, y), 5, c.filled()))),
+        Glyph::Dot => area.draw(&Circle::new((mid, y), 5, c.filled())),
+    }
+    .map_err(plot_err)?;
+    let style = ("sans-serif", size)
+        .into_font()
+        .color(&BLACK)
+        .pos(Pos::new(HPos::Left, VPos::Center));
+    area.draw(&Text::new(
+        e.label.clone(),
+        (x + GLYPH_W + LEGEND_PAD, y),
+        style,
+    ))
+    .map_err(plot_err)
+}
+
+/// Draws `rows` of `entries` from `(x, y)` (the top left of the first row).
+fn draw_rows<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+    entries: &[Entry],
+    rows: &[Vec<(usize, i32)>],
+    size: u32,
+) -> Result<(), Error> {
+    let rh = row_height(size);
+    for (r, row) in rows.iter().enumerate() {
+        for &(i, dx) in row {
+            draw_entry(
+                area,
+                (x + dx, y + r as i32 * rh + rh / 2),
+                &entries[i],
+                size,
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// Size in pixels of a boxed legend listing `entries` one per row.
+fn list_size(entries: &[Entry], size: u32) -> (i32, i32) {
+    let w = entries
+        .iter()
+        .map(|e| entry_width(e, size))
+        .max()
+        .unwrap_or(0);
+    (
+        w + 2 * LEGEND_PAD,
+        entries.len() as i32 * row_height(size) + LEGEND_PAD,
+    )
+}
+
+/// Draws `entries` one per row in a white box with its top left at `at`.
+fn draw_list<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    at: (i32, i32),
+    entries: &[Entry],
+    size: u32,
+    boxed: bool,
+) -> Result<(), Error> {
+    let (w, h) = list_size(entries, size);
+    if boxed {
+        let rect = [at, (at.0 + w, at.1 + h)];
+        area.draw(&Rectangle::new(rect, WHITE.mix(0.9).filled()))
+            .and_then(|_| area.draw(&Rectangle::new(rect, BLACK.stroke_width(1))))
+            .map_err(plot_err)?;
+    }
+    let rows: Vec<Vec<(usize, i32)>> = (0..entries.len()).map(|i| vec![(i, 0)]).collect();
+    draw_rows(
+        area,
+        (at.0 + LEGEND_PAD, at.1 + LEGEND_PAD / 2),
+        entries,
+        &rows,
+        size,
+    )
+}
+
+/// The points a panel draws, in axis units: every point and error bar,
+/// lines and polygon outlines sampled along their segments.
+fn drawn_points(panel: &Panel) -> Vec<(f64, f64)> {
+    let to_axis = |v: f64, log: bool| if log { v.log10() } else { v };
+    let mut pts = Vec::new();
+    let mut push = |x: f64, y: f64| {
+        let (x, y) = (to_axis(x, panel.x_log), to_axis(y, panel.y_log));
+        if x.is_finite() && y.is_finite() {
+            pts.push((x, y));
+        }
+    };
+    for s in &panel.series {
+        let (v, closed) = match &s.mark {
+            Mark::Points(v) => {
+                for &(x, y, e) in v {
+                    push(x, y);
+                    for k in 1..=4 {
+                        let d = e * f64::from(k) / 4.0;
+                        push(x, y - d);
+                        push(x, y + d);
+                    }
+                }
+                continue;
+            }
+            Mark::Circles(v) => {
+                v.iter().for_each(|&(x, y)| push(x, y));
+                continue;
+            }
+            Mark::Line(v) | Mark::Dashed(v) | Mark::Dashes(v) | Mark::Thin(v) => (v, false),
+            Mark::Polygon { vertices, .. } => (vertices, true),
+        };
+        let close = if closed { v.first().copied() } else { None };
+        let line: Vec<(f64, f64)> = v.iter().copied().chain(close).collect();
+        for w in line.windows(2) {
+            for k in 0..16 {
+                let t = f64::from(k) / 16.0;
+                push(
+                    w[0].0 + t * (w[1].0 - w[0].0),
+                    w[0].1 + t * (w[1].1 - w[0].1),
+                );
+            }
+        }
+        if let Some(&(x, y)) = line.last() {
+            push(x, y);
+        }
+    }
+    pts
+}
+
+/// How many of `pts` (axis units) fall in the box of `size` (fractions of
+/// the ranges `(x0, x1)`, `(y0, y1)`) in `corner`.
+fn count_in_corner(
+    pts: &[(f64, f64)],
+    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+    corner: Legend,
+    size: (f64, f64),
+) -> usize {
+    let (left, low) = match corner {
+        Legend::UpperLeft => (true, false),
+        Legend::UpperRight | Legend::Above => (false, false),
+        Legend::LowerLeft => (true, true),
+        Legend::LowerRight => (false, true),
+    };
+    let (w, h) = (size.0 * (x1 - x0), size.1 * (y1 - y0));
+    pts.iter()
+        .filter(|&&(x, y)| {
+            (if left { x <= x0 + w } else { x >= x1 - w })
+                && (if low { y <= y0 + h } else { y >= y1 - h })
+        })
+        .count()
+}
+
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), Error> {
+    let title_style = ("sans-serif", TITLE_SIZE);
+    if p.legend_only {
+        let body = if p.title.is_empty() {
+            area.clone()
+        } else {
+            area.titled(&p.title, title_style).map_err(plot_err)?
+        };
+        let list = entries(&p.series);
+        let at = (MARGIN as i32, MARGIN as i32);
+        return draw_list(&body, at, &list, TITLE_SIZE, false);
+    }
+    let list = entries(&p.series);
+    let dim = area.dim_in_pixel();
+    let aspect = p.equal_aspect && !p.x_log && !p.y_log;
+    let ranges = |plot: (f64, f64)| {
+        let (xr, yr) = bounds(p);
+        if aspect {
+            equal_aspect(plot, xr, yr)
+        } else {
+            (xr, yr)
+        }
+    };
+    // A corner legend stays only where its measured box covers nothing.
+    let mut place = (!list.is_empty()).then_some(p.legend);
+    if let Some(corner) = place.filter(|&c| c != Legend::Above) {
+        let plot = plot_size(dim, &p.title, MARGIN);
+        let (bw, bh) = list_size(&list, LEGEND_SIZE);
+        let size = (
+            f64::from(bw + 2 * LEGEND_INSET) / plot.0,
+            f64::from(bh + 2 * LEGEND_INSET) / plot.1,
+        );
+        if count_in_corner(&drawn_points(p), ranges(plot), corner, size) > 0 {
+            place = Some(Legend::Above);
+        }
+    }
+    let (chart_area, title, top) = if place == Some(Legend::Above) {
+        let left = (MARGIN + Y_LABEL_AREA) as i32;
+        let width = dim.0 as i32 - left - MARGIN as i32;
+        let rows = legend_rows(&list, LEGEND_SIZE, width);
+        let strip = rows.len() as i32 * row_height(LEGEND_SIZE) + LEGEND_PAD;
+        let head_title = title_height(&p.title) as i32;
+        let (head, body) = area.split_vertically(MARGIN as i32 + head_title + strip);
+        if !p.title.is_empty() {
+            let style = title_style
+                .into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Center, VPos::Top));
+            head.draw(&Text::new(
+                p.title.clone(),
+                (dim.0 as i32 / 2, MARGIN as i32 + 5.min(head_title / 4)),
+                style,
+            ))
+            .map_err(plot_err)?;
+        }
+        draw_rows(
+            &head,
+            (left, MARGIN as i32 + head_title),
+            &list,
+            &rows,
+            LEGEND_SIZE,
+        )?;
+        (body, "", 4)
+    } else {
+        (area.clone(), p.title.as_str(), MARGIN)
+    };
+    let ((x0, x1), (y0, y1)) = ranges(plot_size(chart_area.dim_in_pixel(), title, top));
+    let mut builder = ChartBuilder::on(&chart_area);
+    if !title.is_empty() {
+        builder.caption(title, title_style);
+    }
+    let mut chart = builder
         .margin(MARGIN)
-        .x_label_area_size(X_LABEL_AREA * axes)
-        .y_label_area_size(Y_LABEL_AREA * axes)
+        .margin_top(top)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(plot_err)?;
     let fmt_x = |v: &f64| named_tick(*v, p.x_log, &p.x_tick_names);
     let fmt_y = |v: &f64| named_tick(*v, p.y_log, &p.y_tick_names);
-    if !p.legend_only {
-        chart
-            .configure_mesh()
-            .x_desc(p.x_label.as_str())
-            .y_desc(p.y_label.as_str())
-            .x_label_formatter(&fmt_x)
-            .y_label_formatter(&fmt_y)
-            .x_labels(label_count(&p.x_tick_names))
-            .y_labels(label_count(&p.y_tick_names))
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(plot_err)?;
-    }
+    chart
+        .configure_mesh()
+        .x_desc(p.x_label.as_str())
+        .y_desc(p.y_label.as_str())
+        .x_label_formatter(&fmt_x)
+        .y_label_formatter(&fmt_y)
+        .x_labels(label_count(&p.x_tick_names))
+        .y_labels(label_count(&p.y_tick_names))
+        .label_style(("sans-serif", p.tick_size.unwrap_or(AXIS_SIZE)))
+        .axis_desc_style(("sans-serif", AXIS_SIZE))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(plot_err)?;
     if let Some(h) = &p.heat {
         let nx = h.x_edges.len() - 1;
         let cells = h.values.iter().enumerate().map(|(i, &v)| {
@@ -374,151 +772,109 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
         });
         chart.draw_series(cells).map_err(plot_err)?;
     }
-    let mut legend = false;
     for s in &p.series {
         let color = PALETTE[s.color % PALETTE.len()];
         let to_axis = |&(x, y): &(f64, f64)| Some((axis(x, p.x_log)?, axis(y, p.y_log)?));
-        let anno =
-            match &s.mark {
-                Mark::Line(v) => chart
-                    .draw_series(LineSeries::new(
-                        v.iter().filter_map(to_axis),
-                        color.stroke_width(2),
-                    ))
-                    .map_err(plot_err)?,
-                Mark::Dashed(v) => chart
-                    .draw_series(DashedLineSeries::new(
-                        v.iter().filter_map(to_axis),
-                        6,
-                        4,
-                        color.stroke_width(1),
-                    ))
-                    .map_err(plot_err)?,
-                Mark::Points(v) => chart
-                    .draw_series(v.iter().filter_map(|&(x, m, e)| {
-                        let x = axis(x, p.x_log)?;
-                        let mid = axis(m, p.y_log)?;
-                        let lo = axis(m - e, p.y_log).unwrap_or(y0);
-                        let hi = axis(m + e, p.y_log)?;
-                        Some(ErrorBar::new_vertical(x, lo, mid, hi, color.filled(), 6))
-                    }))
-                    .map_err(plot_err)?,
-                Mark::Thin(v) => chart
-                    .draw_series(LineSeries::new(
-                        v.iter().filter_map(to_axis),
-                        color.stroke_width(1),
-                    ))
-                    .map_err(plot_err)?,
-                Mark::Circles(v) => chart
-                    .draw_series(
-                        v.iter()
-                            .filter_map(to_axis)
-                            .map(|c| Circle::new(c, 6, color.stroke_width(2))),
-                    )
-                    .map_err(plot_err)?,
-                Mark::Polygon { vertices, opacity } => {
-                    let v: Vec<(f64, f64)> = vertices.iter().filter_map(to_axis).collect();
-                    chart
-                        .draw_series(std::iter::once(Polygon::new(
-                            v.clone(),
-                            color.mix(opacity.clamp(0.0, 1.0)).filled(),
-                        )))
-                        .map_err(plot_err)?;
-                    let outline = v.first().map(|&first| v.iter().copied().chain([first]));
+        match &s.mark {
+            Mark::Line(v) => chart
+                .draw_series(LineSeries::new(
+                    v.iter().filter_map(to_axis),
+                    color.stroke_width(2),
+                ))
+                .map(|_| ()),
+            Mark::Dashed(v) => chart
+                .draw_series(DashedLineSeries::new(
+                    v.iter().filter_map(to_axis),
+                    6,
+                    4,
+                    color.stroke_width(1),
+                ))
+                .map(|_| ()),
+            Mark::Dashes(v) => chart
+                .draw_series(DashedLineSeries::new(
+                    v.iter().filter_map(to_axis),
+                    9,
+                    6,
+                    color.stroke_width(3),
+                ))
+                .map(|_| ()),
+            Mark::Points(v) => chart
+                .draw_series(v.iter().filter_map(|&(x, m, e)| {
+                    let x = axis(x, p.x_log)?;
+                    let mid = axis(m, p.y_log)?;
+                    let lo = axis(m - e, p.y_log).unwrap_or(y0);
+                    let hi = axis(m + e, p.y_log)?;
+                    Some(ErrorBar::new_vertical(x, lo, mid, hi, color.filled(), 6))
+                }))
+                .map(|_| ()),
+            Mark::Thin(v) => chart
+                .draw_series(LineSeries::new(
+                    v.iter().filter_map(to_axis),
+                    color.stroke_width(1),
+                ))
+                .map(|_| ()),
+            Mark::Circles(v) => chart
+                .draw_series(
+                    v.iter()
+                        .filter_map(to_axis)
+                        .map(|c| Circle::new(c, 6, color.stroke_width(2))),
+                )
+                .map(|_| ()),
+            Mark::Polygon { vertices, opacity } => {
+                let v: Vec<(f64, f64)> = vertices.iter().filter_map(to_axis).collect();
+                let outline = v.first().map(|&first| v.iter().copied().chain([first]));
+                let fill = chart
+                    .draw_series(std::iter::once(Polygon::new(
+                        v.clone(),
+                        color.mix(opacity.clamp(0.0, 1.0)).filled(),
+                    )))
+                    .map(|_| ());
+                fill.and_then(|_| {
                     chart
                         .draw_series(outline.map(|o| {
                             PathElement::new(o.collect::<Vec<_>>(), color.stroke_width(1))
                         }))
-                        .map_err(plot_err)?
-                }
-            };
-        if !s.label.is_empty() {
-            legend = true;
-            let anno = anno.label(s.label.as_str());
-            match Glyph::of(&s.mark) {
-                Glyph::Line(w) => anno.legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(w))
-                }),
-                Glyph::Fill(a) => anno.legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 18, y + 5)], color.mix(a).filled())
-                }),
-                Glyph::Ring => {
-                    anno.legend(move |(x, y)| Circle::new((x + 9, y), 5, color.stroke_width(2)))
-                }
-                Glyph::Dot => anno.legend(move |(x, y)| Circle::new((x + 9, y), 4, color.filled())),
-            };
+                        .map(|_| ())
+                })
+            }
         }
+        .map_err(plot_err)?;
     }
-    if legend && p.legend_only {
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", TITLE_SIZE))
-            .border_style(WHITE)
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()
-            .map_err(plot_err)?;
-    } else if legend {
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(match p.legend {
-                Legend::UpperRight => SeriesLabelPosition::UpperRight,
-                Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
-                Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
-                Legend::LowerRight => SeriesLabelPosition::LowerRight,
-            })
-            .draw()
-            .map_err(plot_err)?;
+    if let Some(corner) = place.filter(|&c| c != Legend::Above) {
+        let (xs, ys) = chart.plotting_area().get_pixel_range();
+        let base = chart_area.get_base_pixel();
+        let (w, h) = list_size(&list, LEGEND_SIZE);
+        let x = match corner {
+            Legend::UpperLeft | Legend::LowerLeft => xs.start + LEGEND_INSET,
+            _ => xs.end - LEGEND_INSET - w,
+        };
+        let y = match corner {
+            Legend::LowerLeft | Legend::LowerRight => ys.end - LEGEND_INSET - h,
+            _ => ys.start + LEGEND_INSET,
+        };
+        draw_list(
+            &chart_area,
+            (x - base.0, y - base.1),
+            &list,
+            LEGEND_SIZE,
+            true,
+        )?;
     }
     Ok(())
 }
 
-/// Legend-sized box of [`single_legend`]: 45% of a chart's width, 40% of
-/// its height.
+/// Legend-sized box of [`quiet_corner`]'s callers: 45% of a chart's width,
+/// 40% of its height.
 pub const LEGEND_BOX: (f64, f64) = (0.45, 0.4);
 
 /// The corner of `panel`'s chart, out of `prefer` (in order of preference),
 /// whose legend-sized box (`size`: fractions of the data ranges' width and
 /// height, e.g. [`LEGEND_BOX`]) covers the fewest drawn points (lines and
-/// polygon outlines sampled along their segments), with that count.
+/// polygon outlines sampled along their segments, error bars), with that
+/// count. The drawing moves the legend above the chart if its measured box
+/// there still covers a point.
 pub fn quiet_corner(panel: &Panel, prefer: &[Legend], size: (f64, f64)) -> (Legend, usize) {
-    let to_axis = |v: f64, log: bool| if log { v.log10() } else { v };
-    let mut pts = Vec::new();
-    let mut push = |x: f64, y: f64| {
-        let (x, y) = (to_axis(x, panel.x_log), to_axis(y, panel.y_log));
-        if x.is_finite() && y.is_finite() {
-            pts.push((x, y));
-        }
-    };
-    for s in &panel.series {
-        let (v, closed) = match &s.mark {
-            Mark::Points(v) => {
-                v.iter().for_each(|&(x, y, _)| push(x, y));
-                continue;
-            }
-            Mark::Circles(v) => {
-                v.iter().for_each(|&(x, y)| push(x, y));
-                continue;
-            }
-            Mark::Line(v) | Mark::Dashed(v) | Mark::Thin(v) => (v, false),
-            Mark::Polygon { vertices, .. } => (vertices, true),
-        };
-        let close = if closed { v.first().copied() } else { None };
-        let line: Vec<(f64, f64)> = v.iter().copied().chain(close).collect();
-        for w in line.windows(2) {
-            for k in 0..8 {
-                let t = f64::from(k) / 8.0;
-                push(
-                    w[0].0 + t * (w[1].0 - w[0].0),
-                    w[0].1 + t * (w[1].1 - w[0].1),
-                );
-            }
-        }
-        if let Some(&(x, y)) = line.last() {
-            push(x, y);
-        }
-    }
+    let pts = drawn_points(panel);
     let span = |f: fn(&(f64, f64)) -> f64| {
         pts.iter()
             .map(f)
@@ -526,46 +882,24 @@ pub fn quiet_corner(panel: &Panel, prefer: &[Legend], size: (f64, f64)) -> (Lege
                 (lo.min(v), hi.max(v))
             })
     };
-    let ((x0, x1), (y0, y1)) = (span(|p| p.0), span(|p| p.1));
-    let covered = |corner: Legend| {
-        let (left, low) = match corner {
-            Legend::UpperLeft => (true, false),
-            Legend::UpperRight => (false, false),
-            Legend::LowerLeft => (true, true),
-            Legend::LowerRight => (false, true),
-        };
-        let (w, h) = (size.0 * (x1 - x0), size.1 * (y1 - y0));
-        pts.iter()
-            .filter(|&&(x, y)| {
-                (if left { x <= x0 + w } else { x >= x1 - w })
-                    && (if low { y <= y0 + h } else { y >= y1 - h })
-            })
-            .count()
-    };
+    let ranges = (span(|p| p.0), span(|p| p.1));
     prefer
         .iter()
-        .map(|&c| (c, covered(c)))
+        .map(|&c| (c, count_in_corner(&pts, ranges, c, size)))
         .min_by_key(|&(_, n)| n)
         .unwrap_or_default()
 }
 
-/// One legend for panels that share their series styles: the panel and
-/// corner (out of `prefer`) where a [`LEGEND_BOX`] covers the fewest points
-/// keeps its labels; the other panels lose theirs.
-pub fn single_legend(panels: &mut [Panel], prefer: &[Legend]) {
-    let best = panels
-        .iter()
-        .enumerate()
-        .map(|(i, p)| (i, quiet_corner(p, prefer, LEGEND_BOX)))
-        .min_by_key(|&(_, (_, n))| n);
-    if let Some((keep, (corner, _))) = best {
-        for (i, p) in panels.iter_mut().enumerate() {
-            if i == keep {
-                p.legend = corner;
-            } else {
-                p.series.iter_mut().for_each(|s| s.label.clear());
-            }
-        }
+/// `x` moved by a small step (2.5 % of a decade on a log axis, of `step`
+/// on a linear one) for the `k`-th of `n` series drawn at the same
+/// abscissae, so that equal estimates of different series stand side by
+/// side instead of on top of each other.
+pub fn spread(x: f64, k: usize, n: usize, log: bool, step: f64) -> f64 {
+    let offset = k as f64 - 0.5 * (n.max(1) - 1) as f64;
+    if log {
+        x * 10f64.powf(0.025 * offset)
+    } else {
+        x + step * offset
     }
 }
 
@@ -629,7 +963,7 @@ fn tick(v: f64, log: bool) -> String {
     } else if v.abs() < 1e-2 || v.abs() >= 1e4 {
         format!("{v:.1e}")
     } else {
-        format!("{v:.3}")
+        format!("{v:.4}")
             .trim_end_matches('0')
             .trim_end_matches('.')
             .to_string()
@@ -643,21 +977,83 @@ impl Figure {
             panels,
             columns: columns.max(1),
             panel_size: (640, 440),
+            legend: Vec::new(),
         }
+    }
+
+    /// Moves the labels of every panel's series (one entry per label) into
+    /// the figure's shared [`legend`](Figure::legend), for panels that
+    /// share their series' styles.
+    pub fn share_legend(mut self) -> Figure {
+        for p in &mut self.panels {
+            for s in &mut p.series {
+                if !s.label.is_empty() && !self.legend.iter().any(|l| l.label == s.label) {
+                    self.legend.push(Series {
+                        label: s.label.clone(),
+                        color: s.color,
+                        mark: match s.mark {
+                            Mark::Points(_) => Mark::Points(match Glyph::of(&s.mark) {
+                                Glyph::Dot => vec![(f64::NAN, f64::NAN, 0.0)],
+                                _ => vec![],
+                            }),
+                            Mark::Circles(_) => Mark::Circles(vec![]),
+                            Mark::Thin(_) => Mark::Thin(vec![]),
+                            Mark::Dashed(_) => Mark::Dashed(vec![]),
+                            Mark::Dashes(_) => Mark::Dashes(vec![]),
+                            Mark::Line(_) => Mark::Line(vec![]),
+                            Mark::Polygon { opacity, .. } => Mark::Polygon {
+                                vertices: vec![],
+                                opacity,
+                            },
+                        },
+                    });
+                }
+                s.label.clear();
+            }
+        }
+        self
+    }
+
+    /// The shared legend's entries and rows, and the strip's height.
+    fn legend_strip(&self) -> (Vec<Entry>, Rows, u32) {
+        let list = entries(&self.legend);
+        if list.is_empty() {
+            return (list, Vec::new(), 0);
+        }
+        let width =
+            (self.panel_size.0 * self.columns as u32) as i32 - 2 * (MARGIN + Y_LABEL_AREA) as i32;
+        let rows = legend_rows(&list, SHARED_LEGEND_SIZE, width);
+        let h = rows.len() as i32 * row_height(SHARED_LEGEND_SIZE) + 2 * MARGIN as i32;
+        (list, rows, h as u32)
     }
 
     fn size(&self) -> (u32, u32) {
         let rows = self.panels.len().div_ceil(self.columns) as u32;
         (
             self.panel_size.0 * self.columns as u32,
-            self.panel_size.1 * rows.max(1),
+            self.panel_size.1 * rows.max(1) + self.legend_strip().2,
         )
     }
 
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), Error> {
         root.fill(&WHITE).map_err(plot_err)?;
-        let rows = self.panels.len().div_ceil(self.columns).max(1);
-        let areas = root.split_evenly((rows, self.columns));
+        let (list, rows, strip) = self.legend_strip();
+        let (head, body) = root.split_vertically(strip);
+        if !list.is_empty() {
+            // The rows centred across the figure.
+            let widest = rows
+                .iter()
+                .filter_map(|r| {
+                    let &(i, x) = r.last()?;
+                    Some(x + entry_width(&list[i], SHARED_LEGEND_SIZE))
+                })
+                .max()
+                .unwrap_or(0);
+            let x = (head.dim_in_pixel().0 as i32 - widest) / 2;
+            draw_rows(&head, (x, MARGIN as i32), &list, &rows, SHARED_LEGEND_SIZE)?;
+        }
+        let grid = self.panels.len().div_ceil(self.columns).max(1);
+        let areas = body.split_evenly((grid, self.columns));
         for (p, area) in self.panels.iter().zip(areas.iter()) {
             draw_panel(area, p)?;
         }

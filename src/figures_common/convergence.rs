@@ -6,7 +6,7 @@ use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::flat::figures::{METHODS, REFERENCE_COLOR, color};
 use crate::method::{Method, Problem};
-use crate::plot::{Legend, Panel, Series, quiet_corner};
+use crate::plot::{Legend, Panel, Series, quiet_corner, spread};
 use crate::rod::figures::convergence::path_counts;
 use serde::Serialize;
 use std::sync::Arc;
@@ -90,11 +90,27 @@ where
 /// the lowest σ at the largest N.
 pub(crate) fn panel(title: String, rows: &[(&str, u64, f64, f64)]) -> Panel {
     let mut series = Vec::new();
-    for method in METHODS {
+    for (k, method) in METHODS.into_iter().enumerate() {
         let rs: Vec<_> = rows.iter().filter(|r| r.0 == method.name()).collect();
         let sigma = rs.iter().map(|r| (r.1 as f64, r.2)).collect();
-        let error = rs.iter().map(|r| (r.1 as f64, r.3.abs(), 0.0)).collect();
-        series.push(Series::line(&super::label(method), color(method), sigma));
+        // The dots side by side, not on top of each other.
+        let error = rs
+            .iter()
+            .map(|r| {
+                (
+                    spread(r.1 as f64, k, METHODS.len(), true, 0.0),
+                    r.3.abs(),
+                    0.0,
+                )
+            })
+            .collect();
+        let label = super::label(method);
+        // Transport's σ lies on rendering's: dashed over it.
+        if method == Method::Transport {
+            series.push(Series::dashes(&label, color(method), sigma));
+        } else {
+            series.push(Series::line(&label, color(method), sigma));
+        }
         series.push(Series::points("", color(method), error));
     }
     // The reference slope, a factor 3 under the lowest σ at the largest N
@@ -116,6 +132,14 @@ pub(crate) fn panel(title: String, rows: &[(&str, u64, f64, f64)]) -> Panel {
             vec![(lo, k / lo.sqrt()), (hi, k / hi.sqrt())],
         ));
     }
+    // What lines and dots are, first in the legend (they draw nothing).
+    series.splice(
+        0..0,
+        [
+            Series::line("σ (lines)", REFERENCE_COLOR, vec![]),
+            Series::legend_dot("|mean − exact| (dots)", REFERENCE_COLOR),
+        ],
+    );
     let mut panel = Panel {
         title,
         x_label: "N (paths)".into(),

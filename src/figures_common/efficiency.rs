@@ -6,7 +6,7 @@ use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::flat::figures::{METHODS, color};
 use crate::method::{Method, Problem};
-use crate::plot::{Figure, Legend, Panel, Series, single_legend};
+use crate::plot::{Figure, Panel, Series};
 use crate::runner::RunResult;
 use crate::stats::Estimate;
 use serde::Serialize;
@@ -203,11 +203,13 @@ where
     let lo = works.clone().fold(f64::INFINITY, f64::min);
     let hi = works.fold(0.0f64, f64::max);
     let (floor, top) = if lo.is_finite() && hi > 0.0 {
-        (10f64.powf(lo.log10().floor()), hi * spec.headroom)
+        // A decade at least half a decade under the smallest bar, so that
+        // every bar shows its height.
+        (10f64.powf((lo.log10() - 0.5).floor()), hi * spec.headroom)
     } else {
         (1e-12, 1.0)
     };
-    let mut panels: Vec<Panel> = spec
+    let panels: Vec<Panel> = spec
         .scenes
         .iter()
         .zip(&groups)
@@ -220,8 +222,7 @@ where
             panel((spec.title)(name), g, &rs, floor, top)
         })
         .collect();
-    single_legend(&mut panels, &[Legend::UpperRight, Legend::UpperLeft]);
-    let mut figure = Figure::new(panels, 1);
+    let mut figure = Figure::new(panels, 1).share_legend();
     figure.panel_size = spec.panel_size;
     save(opts, spec.prefix, "efficiency", &figure, &records)
 }

@@ -1,11 +1,14 @@
 //! The runs of the flatland and 3D stability figures: every derivative
 //! method ([`DERIVATIVE_METHODS`]) on a scene built at each distance to a
-//! singular configuration, the sensitivity to its parameter `p` judged.
+//! singular configuration, the sensitivity to its parameter `p` judged;
+//! and the two rows of panels that show them (the per-path variance with
+//! its error bar, and the bias).
 use super::{FigureOptions, get, run_method};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::flat::figures::DERIVATIVE_METHODS;
+use crate::flat::figures::{DERIVATIVE_METHODS, REFERENCE_COLOR, color};
 use crate::method::Problem;
+use crate::plot::{Panel, Series, spread};
 use crate::stats::Estimate;
 use serde::Serialize;
 use std::sync::Arc;
@@ -36,23 +39,34 @@ pub struct Record {
     pub z: Option<f64>,
 }
 
-/// One case: its name, its distances, and the scene (parameter `p`) at a
-/// distance with its exact `∂E/∂p` if known.
+/// One case: its name, its distances, its paths per run (times the
+/// effort), and the scene (parameter `p`) at a distance with its exact
+/// `∂E/∂p` if known.
 pub(crate) type Case<'a, S> = (
     &'static str,
     &'a [f64],
+    u64,
     &'a dyn Fn(f64) -> Result<(S, Option<f64>), Error>,
 );
 
-/// Runs every derivative method with `paths` paths on `opts.threads` at
-/// every distance of every case, one salt a run from `salt` on; `z` scores
-/// an estimate against the exact value. `what` names the progress bar.
+/// The seeds of the runs: `opts.seed` plus a salt.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Salt {
+    /// One salt a run from this one on.
+    Each(u64),
+    /// This salt for every run (common random numbers across the runs, as
+    /// a test that runs each with one seed).
+    All(u64),
+}
+
+/// Runs every derivative method on `opts.threads` at every distance of
+/// every case, seeds from `salt`; `z` scores an estimate against the exact
+/// value. `what` names the progress bar.
 pub(crate) fn measure<S>(
     opts: &FigureOptions,
     what: &str,
     cases: &[Case<'_, S>],
-    paths: u64,
-    mut salt: u64,
+    salt: Salt,
     z: fn(&Estimate, f64) -> Option<f64>,
 ) -> Result<Vec<Record>, Error>
 where
@@ -61,13 +75,18 @@ where
     let total: usize = cases.iter().map(|c| c.1.len()).sum();
     let bar = opts.bar((total * DERIVATIVE_METHODS.len()) as u64, what);
     let mut records = Vec::new();
-    for &(case, distances, build) in cases {
+    let mut next = match salt {
+        Salt::Each(s) | Salt::All(s) => s,
+    };
+    for &(case, distances, paths, build) in cases {
         for &distance in distances {
             let (scene, exact) = build(distance)?;
             let scene = Arc::new(scene);
             for method in DERIVATIVE_METHODS {
-                salt += 1;
-                let r = run_method(opts, method, &scene, paths, salt, opts.threads)?;
+                if let Salt::Each(_) = salt {
+                    next += 1;
+                }
+                let r = run_method(opts, method, &scene, paths, next, opts.threads)?;
                 let e = get(&r, &Quantity::sensitivity("p"))?;
                 records.push(Record {
                     case,
@@ -87,4 +106,101 @@ where
     }
     bar.finish();
     Ok(records)
+}
+
+/// The case's per-path variance `σ²N` of `∂E/∂p` (named `derivative`, e.g.
+/// `"∂E/∂π"`) against the distance, log–log, every derivative method as
+/// points with error bars `±σ²N·√VOV` (the VOV is the relative variance of
+/// the variance estimate), the methods side by side.
+pub(crate) fn variance_panel(
+    case: &str,
+    title: &str,
+    axis: &str,
+    derivative: &str,
+    records: &[Record],
+) -> Panel {
+    let n = DERIVATIVE_METHODS.len();
+    let series = DERIVATIVE_METHODS
+        .iter()
+        .enumerate()
+        .map(|(k, &m)| {
+            let pts = records
+                .iter()
+                .filter(|r| {
+                    r.case == case && r.method == m.name() && r.variance > 0.0 && r.distance > 0.0
+                })
+                .map(|r| {
+                    (
+                        spread(r.distance, k, n, true, 0.0),
+                        r.variance,
+                        r.variance * r.vov.max(0.0).sqrt(),
+                    )
+                })
+                .collect();
+            Series::points(m.name(), color(m), pts)
+        })
+        .collect();
+    Panel {
+        title: title.into(),
+        x_label: axis.into(),
+        y_label: format!("σ² N of {derivative} (bars: ±σ²N·√VOV)"),
+        x_log: true,
+        y_log: true,
+        series,
+        ..Panel::default()
+    }
+}
+
+/// The case's bias against the distance: `(mean − exact)/σ` with a bar of
+/// one, clamped to ±12, dashed lines at ±4, where every run has an exact
+/// value; the estimates themselves (`mean ± σ`) where not.
+pub(crate) fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Record]) -> Panel {
+    let mine: Vec<&Record> = records
+        .iter()
+        .filter(|r| r.case == case && r.distance > 0.0)
+        .collect();
+    let has_exact = mine.iter().all(|r| r.exact.is_some());
+    let (lo, hi) = mine.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+        (lo.min(r.distance), hi.max(r.distance))
+    });
+    let n = DERIVATIVE_METHODS.len();
+    let mut series = Vec::new();
+    for (k, &m) in DERIVATIVE_METHODS.iter().enumerate() {
+        let pts = mine
+            .iter()
+            .filter(|r| r.method == m.name())
+            .filter_map(|r| {
+                let x = spread(r.distance, k, n, true, 0.0);
+                if has_exact {
+                    // z with a bar of one (the error bar in units of σ);
+                    // clamped to the panel so that a far-off point shows.
+                    r.z.map(|z| (x, z.clamp(-12.0, 12.0), 1.0))
+                } else {
+                    Some((x, r.mean, r.stderr))
+                }
+            })
+            .collect();
+        series.push(Series::points("", color(m), pts));
+    }
+    if has_exact {
+        for y in [-4.0, 4.0] {
+            series.push(Series::dashed("", REFERENCE_COLOR, vec![(lo, y), (hi, y)]));
+        }
+    }
+    Panel {
+        title: if has_exact {
+            "bias (mean − exact)/σ, clamped ±12; dashed ±4".into()
+        } else {
+            "no closed form: the estimates, mean ± σ".into()
+        },
+        x_label: axis.into(),
+        y_label: if has_exact {
+            "(mean − exact)/σ".into()
+        } else {
+            derivative.into()
+        },
+        x_log: true,
+        series,
+        ..Panel::default()
+    }
 }

@@ -50,7 +50,7 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         min_seconds: MIN_SECONDS,
         max_repeats: MAX_REPEATS,
         salt: SALT,
-        headroom: 6.0,
+        headroom: 2.0,
         panel_size: (1500, 440),
     };
     efficiency::efficiency(opts, &spec)

@@ -81,6 +81,8 @@ pub fn scene_file(name: &str) -> Option<&'static str> {
         "reflector" => include_str!("../../../scenes/reflector.toml"),
         "three_shapes" => include_str!("../../../scenes/three_shapes.toml"),
         "radiance" => include_str!("../../../scenes/radiance.toml"),
+        "submerged" => include_str!("../../../scenes/submerged.toml"),
+        "camera_line" => include_str!("../../../scenes/camera_line.toml"),
         _ => return None,
     })
 }

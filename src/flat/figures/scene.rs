@@ -9,7 +9,9 @@
 //! sees changes across the corner's direction (a silhouette: the corner
 //! term can be nonzero) and in yellow where it does not (a reflex or front
 //! corner: the term vanishes). A radiance sensor (radiance.toml) looks
-//! along one direction and has no corners of its own.
+//! along one direction and has no corners of its own; the line camera
+//! (camera_line.toml) is drawn with its paths fanned across its field of
+//! view, without corner rings.
 //! One panel per shipped scene ([`SCENES`]) and one for the legend.
 //!
 //! The drawing helpers ([`shapes`], [`sensor`], [`ViewBox`]) serve the warp
@@ -28,7 +30,7 @@ use serde::Serialize;
 use std::path::PathBuf;
 
 /// The scenes drawn, one panel each.
-pub const SCENES: [&str; 7] = [
+pub const SCENES: [&str; 9] = [
     "occluder",
     "polygon_occluder",
     "absorbing_slab",
@@ -36,6 +38,8 @@ pub const SCENES: [&str; 7] = [
     "reflector",
     "three_shapes",
     "radiance",
+    "submerged",
+    "camera_line",
 ];
 
 /// Paths drawn per scene.
@@ -277,16 +281,25 @@ pub struct SceneRecord {
 
 /// The first [`PATHS`] paths of the intensity estimator's first chunk with
 /// seed `seed` (an irradiance sensor draws its direction first, as the
-/// estimator does).
+/// estimator does; a camera's paths fan out evenly across its field of
+/// view, one direction each, instead of one pixel's).
 pub fn sample_paths(scene: &Scene, seed: u64) -> Vec<PathRecord> {
     let mut rng = rng::stream(seed, 0);
     let x = scene.sensor().point();
     let plane = Plane::new(std::sync::Arc::new(scene.clone()));
     (0..PATHS)
-        .map(|_| {
+        .map(|i| {
             let (w, factor) = match scene.sensor() {
-                Sensor::Radiance { direction, .. } | Sensor::Camera { direction, .. } => {
-                    (direction, 1.0)
+                Sensor::Radiance { direction, .. } => (direction, 1.0),
+                // A camera's paths fan out evenly across its field of view.
+                Sensor::Camera {
+                    direction, fov_deg, ..
+                } => {
+                    let u = (i as f64 + 0.5) / PATHS as f64 - 0.5;
+                    (
+                        DVec2::from_angle(u * fov_deg.to_radians()).rotate(direction),
+                        1.0,
+                    )
                 }
                 Sensor::Irradiance { normal, .. } => (cosine_direction(normal, &mut rng), 2.0),
             };
@@ -446,9 +459,9 @@ fn panel(name: &str, scene: &Scene, seed: u64) -> (Panel, SceneRecord) {
 }
 
 /// The scenes drawn with their paths and boundary points, one panel per
-/// scene of [`SCENES`] (2 × 2). Writes `flat_scene.{png,svg}` and
+/// scene of [`SCENES`] (4 per row, the legend last). Writes `flat_scene.{png,svg}` and
 /// `flat_scene.json` (the paths, the hits and the corners). Samples only
-/// `4 × 20` paths: the effort does not change it.
+/// 20 paths per scene: the effort does not change it.
 pub fn scene(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let mut panels = Vec::new();
     let mut records = Vec::new();
@@ -475,7 +488,7 @@ fn legend() -> Panel {
             vec![],
         ),
         Series::thin("path carrying none", colors::DARK, vec![]),
-        Series::points("path meets a moving boundary", colors::MARK, vec![]),
+        Series::legend_dot("path meets a moving boundary", colors::MARK),
         Series::circles("moving silhouette corner in view", colors::MARK, vec![]),
         Series::circles("other moving corner in view", colors::STILL, vec![]),
     ]);
@@ -490,6 +503,23 @@ fn legend() -> Panel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_shipped_scene_is_drawn() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let mut shipped: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .filter_map(|e| {
+                let path = e.ok()?.path();
+                (path.extension()? == "toml")
+                    .then(|| path.file_stem()?.to_str().map(String::from))?
+            })
+            .collect();
+        shipped.sort();
+        let mut drawn: Vec<String> = SCENES.iter().map(|s| s.to_string()).collect();
+        drawn.sort();
+        assert_eq!(shipped, drawn);
+    }
 
     #[test]
     fn clipping_keeps_the_inside() {

@@ -156,9 +156,10 @@ fn arrow(a: DVec2, b: DVec2, head: f64) -> Vec<(f64, f64)> {
     v
 }
 
-/// The scene with a fan of rays from the sensor and, at each ray's end, the
-/// arrow `t V_j(φ) ω⊥` of parameter `j` (colour `color`), scaled so the
-/// longest is a tenth of the scene.
+/// The scene with a fan of rays from the sensor and, at the end of each ray
+/// that hits a shape (rays that hit nothing have no end to move), the arrow
+/// `t V_j(φ) ω⊥` of parameter `j` (colour `color`), scaled so the longest is
+/// a tenth of the scene.
 fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel {
     let scene: &Scene = plane.scene();
     let view = ViewBox::of(scene, 0.08);
@@ -166,23 +167,30 @@ fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel 
     let (x, phi_n) = frame(scene);
     let mut series = shapes(scene, 0.025 * size);
     // Per ray: its end (the first hit, or where it leaves the view) and the
-    // arrow there.
-    let ends: Vec<(DVec2, DVec2)> = (0..FAN)
+    // arrow there, `None` for a ray that hits nothing (no end moves).
+    let ends: Vec<(DVec2, Option<DVec2>)> = (0..FAN)
         .map(|i| {
             let phi = phi_n - std::f64::consts::FRAC_PI_2
                 + std::f64::consts::PI * (i as f64 + 0.5) / FAN as f64;
             let w = direction(phi);
-            let t = scene.cast(x, w, NO_SEGMENT).map_or_else(
-                || {
-                    view.clip(x, x + 4.0 * size * w)
-                        .map_or(0.0, |(_, b)| (b - x).length())
-                },
-                |h| h.t,
-            );
-            (x + t * w, t * sensor_warp(plane, phi)[j] * perp(w))
+            match scene.cast(x, w, NO_SEGMENT) {
+                Some(h) => (
+                    x + h.t * w,
+                    Some(h.t * sensor_warp(plane, phi)[j] * perp(w)),
+                ),
+                None => {
+                    let t = view
+                        .clip(x, x + 4.0 * size * w)
+                        .map_or(0.0, |(_, b)| (b - x).length());
+                    (x + t * w, None)
+                }
+            }
         })
         .collect();
-    let longest = ends.iter().map(|e| e.1.length()).fold(0.0, f64::max);
+    let longest = ends
+        .iter()
+        .filter_map(|e| e.1.map(DVec2::length))
+        .fold(0.0, f64::max);
     let scale = if longest > 0.0 {
         0.1 * size / longest
     } else {
@@ -208,11 +216,12 @@ fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel 
     }
     let mut labelled = false;
     for &(end, v) in &ends {
+        let Some(v) = v else { continue };
         if v.length() * scale > 1e-4 * size {
             let label = if labelled {
                 ""
             } else {
-                "t·V(φ)·ω⊥ at the ray's end"
+                "t·V(φ)·ω⊥ where the ray hits"
             };
             labelled = true;
             series.push(Series::line(

@@ -168,23 +168,22 @@ fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
     })
 }
 
-/// The legend panel: the closed form and every method.
-fn legend() -> Panel {
-    let mut series = vec![Series::line("closed form", REFERENCE_COLOR, vec![])];
+/// The figure's legend: the closed form and every method.
+fn legend() -> Vec<Series> {
+    let mut series = vec![Series::line(
+        "closed form (black triangle at z = 1 under the unit lamp at z = 2)",
+        REFERENCE_COLOR,
+        vec![],
+    )];
     for method in sweep::methods() {
         series.push(Series::points(&label(method), color(method), vec![]));
     }
-    Panel {
-        title: "black triangle at z = 1 under the unit lamp at z = 2".into(),
-        series,
-        legend_only: true,
-        ..Panel::default()
-    }
+    series
 }
 
 /// `E` and `∂E/∂π` against `π` for the black triangle occluder's
 /// translation along x, rotation and scale ([`SWEEPS`], columns; `E` on the
-/// top row, `∂E/∂π` below, the legend in a panel of its own at the right),
+/// top row, `∂E/∂π` below, the legend across the top),
 /// every Monte Carlo method as markers with ±σ bars ([`PATHS`] paths per
 /// run on `opts.threads`) over the closed form as a line. Writes
 /// `mesh_against_pi.{png,svg,json}`:
@@ -204,9 +203,9 @@ pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     )?;
     bar.finish();
     let (records, curves, mut top) = (columns.records, columns.curves, columns.top);
-    top.push(legend());
     top.extend(columns.bottom);
-    let mut figure = Figure::new(top, SWEEPS.len() + 1);
+    let mut figure = Figure::new(top, SWEEPS.len());
+    figure.legend = legend();
     figure.panel_size = (560, 440);
     let o = TriangleOccluder::NOMINAL;
     let numbers = AgainstPi {

@@ -50,7 +50,7 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             panel(title, &rows)
         })
         .collect();
-    let mut figure = Figure::new(panels, 2);
+    let mut figure = Figure::new(panels, 2).share_legend();
     figure.panel_size = (760, 560);
     save(opts, "convergence", &figure, &records)
 }

@@ -66,7 +66,7 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         min_seconds: MIN_SECONDS,
         max_repeats: MAX_REPEATS,
         salt: SALT,
-        headroom: 30.0,
+        headroom: 2.0,
         panel_size: (1200, 420),
     };
     efficiency::efficiency(opts, &spec)

@@ -23,12 +23,12 @@
 //!
 //! Finite differences are drawn too; their half step (2·10⁻³ of the scene's
 //! size) is larger than some of the distances, where they are biased.
-use super::{DERIVATIVE_METHODS, FigureOptions, REFERENCE_COLOR, color, save, z};
+use super::{FigureOptions, save, z};
 use crate::error::Error;
-use crate::figures_common::stability::{self, measure};
+use crate::figures_common::stability::{self, Salt, bias_panel, measure, variance_panel};
 use crate::mesh::Scene;
 use crate::mesh::cases::{self, Case};
-use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
+use crate::plot::{Figure, Panel};
 use std::path::PathBuf;
 
 /// Paths per run (times the effort).
@@ -82,92 +82,6 @@ const CASES: [CaseSpec; 4] = [
     ),
 ];
 
-fn top(case: &str, title: &str, axis: &str, records: &[Record]) -> Panel {
-    let series = DERIVATIVE_METHODS
-        .iter()
-        .map(|&m| {
-            let pts = records
-                .iter()
-                .filter(|r| {
-                    r.case == case && r.method == m.name() && r.variance > 0.0 && r.distance > 0.0
-                })
-                .map(|r| (r.distance, r.variance, r.variance * r.vov.max(0.0).sqrt()))
-                .collect();
-            Series::points(m.name(), color(m), pts)
-        })
-        .collect();
-    let mut panel = Panel {
-        title: title.into(),
-        x_label: axis.into(),
-        y_label: "σ² N of ∂E/∂p (bars: ±σ²N·√VOV)".into(),
-        x_log: true,
-        y_log: true,
-        series,
-        ..Panel::default()
-    };
-    let corners = [
-        Legend::UpperRight,
-        Legend::LowerLeft,
-        Legend::LowerRight,
-        Legend::UpperLeft,
-    ];
-    panel.legend = quiet_corner(&panel, &corners, (0.3, 0.35)).0;
-    panel
-}
-
-fn bottom(case: &str, axis: &str, records: &[Record]) -> Panel {
-    let mine: Vec<&Record> = records
-        .iter()
-        .filter(|r| r.case == case && r.distance > 0.0)
-        .collect();
-    let has_exact = mine.iter().all(|r| r.exact.is_some());
-    let ds: Vec<f64> = mine.iter().map(|r| r.distance).collect();
-    let (lo, hi) = ds.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
-        (lo.min(d), hi.max(d))
-    });
-    let mut series = Vec::new();
-    // Methods side by side (a factor per method on the log axis).
-    let k_mid = 0.5 * (DERIVATIVE_METHODS.len() - 1) as f64;
-    for (k, &m) in DERIVATIVE_METHODS.iter().enumerate() {
-        let shift = 10f64.powf((k as f64 - k_mid) * 0.04);
-        let pts = mine
-            .iter()
-            .filter(|r| r.method == m.name())
-            .filter_map(|r| {
-                if has_exact {
-                    // z with a bar of one (the error bar in units of σ);
-                    // clamped to the panel so that a far-off point shows.
-                    r.z.map(|z| (r.distance * shift, z.clamp(-12.0, 12.0), 1.0))
-                } else {
-                    Some((r.distance * shift, r.mean, r.stderr))
-                }
-            })
-            .collect();
-        series.push(Series::points("", color(m), pts));
-    }
-    if has_exact {
-        for y in [-4.0, 4.0] {
-            series.push(Series::dashed("", REFERENCE_COLOR, vec![(lo, y), (hi, y)]));
-        }
-    }
-    Panel {
-        title: if has_exact {
-            "bias: (mean − closed form)/σ, clamped to ±12; dashed ±4".into()
-        } else {
-            "no closed form: the estimates, mean ± σ".into()
-        },
-        x_label: axis.into(),
-        y_label: if has_exact {
-            "(mean − exact)/σ".into()
-        } else {
-            "∂E/∂p".into()
-        },
-        x_log: true,
-        series,
-        ..Panel::default()
-    }
-}
-
 /// σ²N and the bias of `∂E/∂p` of every derivative method against the
 /// distance to four singular configurations (columns; see the module docs),
 /// [`PATHS`] paths per run on `opts.threads`. Writes
@@ -179,21 +93,21 @@ fn bottom(case: &str, axis: &str, records: &[Record]) -> Panel {
 pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let cases: Vec<stability::Case<'_, Scene>> = CASES
         .iter()
-        .map(|(case, _, _, distances, build)| (*case, *distances, build as _))
+        .map(|(case, _, _, distances, build)| (*case, *distances, PATHS, build as _))
         .collect();
-    let records = measure(opts, "mesh: stability", &cases, PATHS, SALT, |e, x| {
+    let records = measure(opts, "mesh: stability", &cases, Salt::Each(SALT), |e, x| {
         z(e.mean, e.stderr, x)
     })?;
     let mut panels: Vec<Panel> = CASES
         .iter()
-        .map(|&(case, title, axis, _, _)| top(case, title, axis, &records))
+        .map(|&(case, title, axis, _, _)| variance_panel(case, title, axis, "∂E/∂p", &records))
         .collect();
     panels.extend(
         CASES
             .iter()
-            .map(|&(case, _, axis, _, _)| bottom(case, axis, &records)),
+            .map(|&(case, _, axis, _, _)| bias_panel(case, axis, "∂E/∂p", &records)),
     );
-    let mut figure = Figure::new(panels, CASES.len());
-    figure.panel_size = (540, 440);
+    let mut figure = Figure::new(panels, CASES.len()).share_legend();
+    figure.panel_size = (480, 420);
     save(opts, "stability", &figure, &records)
 }

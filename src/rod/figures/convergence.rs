@@ -12,7 +12,7 @@
 use super::{FigureOptions, exact_value, thick, thin};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::plot::{Figure, Legend, Panel, Series, single_legend};
+use crate::plot::{Figure, Panel, Series, spread};
 use crate::rod::{Direction, Method, PARAMETER, Rod};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -174,7 +174,8 @@ pub(super) fn error_panel(
     x_of: fn(&Record) -> f64,
 ) -> Panel {
     let mut series = Vec::new();
-    for method in Method::UNBIASED {
+    let n = Method::UNBIASED.len();
+    for (k, method) in Method::UNBIASED.into_iter().enumerate() {
         let mut rs: Vec<&Record> = records
             .iter()
             .filter(|r| r.method == method.name())
@@ -185,8 +186,18 @@ pub(super) fn error_panel(
         rs.sort_by(|a, b| x_of(a).total_cmp(&x_of(b)));
         let (label, color) = style(method);
         let sigma = rs.iter().map(|r| (x_of(r), r.stderr)).collect();
-        let error = rs.iter().map(|r| (x_of(r), r.error.abs(), 0.0)).collect();
-        series.push(Series::line(&label, color, sigma));
+        // The dots side by side: methods that draw the same random numbers
+        // give the same error.
+        let error = rs
+            .iter()
+            .map(|r| (spread(x_of(r), k, n, true, 0.0), r.error.abs(), 0.0))
+            .collect();
+        // Transport's σ equals rendering's at most probes: dashed over it.
+        if method == Method::Transport {
+            series.push(Series::dashes(&label, color, sigma));
+        } else {
+            series.push(Series::line(&label, color, sigma));
+        }
         series.push(Series::points("", color, error));
     }
     let xs = records.iter().map(x_of);
@@ -210,6 +221,14 @@ pub(super) fn error_panel(
             vec![(lo, c / lo.sqrt()), (hi, c / hi.sqrt())],
         ));
     }
+    // What lines and dots are, first in the legend (they draw nothing).
+    series.splice(
+        0..0,
+        [
+            Series::line("σ (lines)", REFERENCE_COLOR, vec![]),
+            Series::legend_dot("|mean − exact| (dots)", REFERENCE_COLOR),
+        ],
+    );
     Panel {
         title,
         x_label: x_label.into(),
@@ -220,9 +239,6 @@ pub(super) fn error_panel(
         ..Panel::default()
     }
 }
-
-/// Where falling curves on log–log axes leave room for a legend.
-pub(super) const FALLING: [Legend; 2] = [Legend::LowerLeft, Legend::UpperRight];
 
 /// The convergence figure: σ and |error| against N (10² to 10⁷ paths in
 /// half decades, times the effort; a fresh seed per run) for every method,
@@ -267,9 +283,10 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         }
     }
     bar.finish();
-    single_legend(&mut panels, &FALLING);
     let json = opts.write_json("convergence", &records)?;
-    let mut written = Figure::new(panels, 2).save(&opts.out, "convergence")?;
+    let mut written = Figure::new(panels, 2)
+        .share_legend()
+        .save(&opts.out, "convergence")?;
     written.push(json);
     Ok(written)
 }

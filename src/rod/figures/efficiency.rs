@@ -12,11 +12,11 @@
 //! Points with `σ = 0` (a probe where every path scores the same, e.g. at
 //! `x = 0`, `ω = +1`) cannot be drawn on the log axis and are left out.
 use super::convergence::{
-    Case, FALLING, NEAR_END, Record, error_panel, omega_label, path_counts, rod_title, rods, style,
+    Case, NEAR_END, Record, error_panel, omega_label, path_counts, rod_title, rods, style,
 };
 use super::{FigureOptions, positions};
 use crate::error::Error;
-use crate::plot::{Figure, Legend, Panel, Series, single_legend};
+use crate::plot::{Figure, Panel, Series};
 use crate::rod::{Direction, Method};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -65,7 +65,12 @@ fn work_panel(title: String, records: &[Record]) -> Panel {
             color,
             xy.iter().map(|&(x, w)| (x, w, 0.0)).collect(),
         ));
-        series.push(Series::line(&label, color, xy));
+        // Dashed as in the error panels, where it lies on rendering.
+        series.push(if method == Method::Transport {
+            Series::dashes(&label, color, xy)
+        } else {
+            Series::line(&label, color, xy)
+        });
     }
     Panel {
         title,
@@ -180,15 +185,6 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         ));
     }
     bar.finish();
-    let (work_panels, time_panels) = panels.split_at_mut(2 * directions.len());
-    let corners = [
-        Legend::UpperRight,
-        Legend::UpperLeft,
-        Legend::LowerRight,
-        Legend::LowerLeft,
-    ];
-    single_legend(work_panels, &corners);
-    single_legend(time_panels, &FALLING);
     let json = opts.write_json(
         "efficiency",
         &Efficiency {
@@ -196,7 +192,14 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             error_vs_time,
         },
     )?;
-    let mut written = Figure::new(panels, 2).save(&opts.out, "efficiency")?;
+    let mut figure = Figure::new(panels, 2).share_legend();
+    // The lines are σ and the dots the errors only in the bottom row.
+    for s in &mut figure.legend {
+        if s.label.ends_with("(lines)") || s.label.ends_with("(dots)") {
+            s.label.insert_str(s.label.len() - 1, ", bottom row");
+        }
+    }
+    let mut written = figure.save(&opts.out, "efficiency")?;
     written.push(json);
     Ok(written)
 }

@@ -290,6 +290,7 @@ fn panel(cells: &[&Cell], thicknesses: &[f64], title: String) -> Panel {
         title,
         x_label: "x / length (non-uniform grid)".into(),
         x_tick_names: position_names(),
+        tick_size: Some(13),
         y_label: "optical thickness κe × length".into(),
         y_tick_names: thicknesses.iter().map(|&t| two_digits(t)).collect(),
         series: vec![
@@ -315,15 +316,18 @@ fn legend(record: &Record) -> Panel {
         ),
         "colour: coverage, fraction of runs with |mean − s| ≤ 2σ (honest: 0.954)",
         COVERAGE_RANGE,
-        (COVERAGE_RANGE.1, 1.0),
+        (0.0, 1.0),
     );
+    // The scale is linear down to its red end and saturates below it.
+    let red = COVERAGE_RANGE.1;
     bar.series.extend([
-        Series::points("most runs flagged (VOV ≥ 0.1)", FLAGGED_COLOR, vec![]),
-        Series::points(
-            "most runs report σ = 0 (no weight drawn)",
-            ZERO_COLOR,
-            vec![],
+        Series::line(
+            &format!("colour saturates below {red:.2}"),
+            FLAGGED_COLOR,
+            vec![(red, -0.5), (red, 0.5)],
         ),
+        Series::legend_dot("most runs flagged (VOV ≥ 0.1)", FLAGGED_COLOR),
+        Series::legend_dot("most runs report σ = 0 (no weight drawn)", ZERO_COLOR),
     ]);
     bar
 }
