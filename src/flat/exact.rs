@@ -758,6 +758,70 @@ impl Reference {
     }
 }
 
+/// The exact image of a flatland line camera looking at emitters and black
+/// absorbers (no reflector, no medium): per pixel, the mean over its
+/// footprint on the image line of the radiance of the first surface seen.
+/// Between the projections of the corners the first surface seen does not
+/// change (shapes are disjoint), so one ray per such interval gives it
+/// exactly. `None` if the sensor is not a line camera or the scene holds a
+/// reflector or a medium.
+pub fn line_camera_image(scene: &super::Scene) -> Option<Vec<f64>> {
+    use super::geometry::NO_SEGMENT;
+    use crate::path::Surface;
+    let super::Sensor::Camera {
+        position,
+        direction,
+        fov_deg,
+        width,
+    } = scene.sensor()
+    else {
+        return None;
+    };
+    if scene
+        .shapes()
+        .iter()
+        .any(|s| s.medium.is_some() || matches!(s.surface, Surface::Reflector { .. }))
+    {
+        return None;
+    }
+    let r = DVec2::new(direction.y, -direction.x);
+    let half = (0.5 * fov_deg.to_radians()).tan();
+    let d = 2.0 * half / f64::from(width);
+    // Where each corner projects on the image line (those in front).
+    let mut cuts: Vec<f64> = scene
+        .corners()
+        .iter()
+        .filter_map(|(q, _)| {
+            let v = *q - position;
+            let z = v.dot(direction);
+            (z > 0.0).then(|| v.dot(r) / z)
+        })
+        .collect();
+    cuts.extend((0..=width).map(|p| -half + d * f64::from(p)));
+    cuts.retain(|x| x.abs() <= half);
+    cuts.sort_by(f64::total_cmp);
+    cuts.dedup();
+    let mut image = vec![0.0; width as usize];
+    for w in cuts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b <= a {
+            continue;
+        }
+        let m = 0.5 * (a + b);
+        let dir = (direction + r * m).normalize();
+        let radiance = match scene.cast(position, dir, NO_SEGMENT) {
+            Some(h) => match scene.shape_of(h.segment).surface {
+                Surface::Emitter { radiance } => radiance,
+                _ => 0.0,
+            },
+            None => 0.0,
+        };
+        let p = (((m + half) / d).floor() as usize).min(width as usize - 1);
+        image[p] += radiance * (b - a) / d;
+    }
+    Some(image)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

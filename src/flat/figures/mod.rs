@@ -18,6 +18,7 @@ use std::sync::Arc;
 pub use crate::rod::figures::{FigureFn, FigureOptions};
 
 pub mod against_pi;
+pub mod camera;
 pub mod convergence;
 pub mod efficiency;
 pub mod scene;
@@ -66,6 +67,7 @@ pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             convergence::convergence,
             efficiency::efficiency,
             stability::stability,
+            camera::camera,
         ],
     )
 }
