@@ -16,7 +16,6 @@ use crate::estimator::{Estimator, Quantity};
 use crate::rng;
 use crate::stats::{Estimate, Moments, StratumSums};
 use rayon::prelude::*;
-use std::time::Instant;
 
 /// Most paths per pixel.
 pub const MAX_SPP: u64 = 1 << 32;
@@ -99,22 +98,13 @@ pub fn render(
         progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
         out
     };
-    let start;
-    let rows: Vec<Vec<Vec<StratumSums>>> = if threads == 1 {
-        start = Instant::now();
-        (0..height).map(row).collect()
-    } else if threads == 0 {
-        start = Instant::now();
-        (0..height).into_par_iter().map(row).collect()
-    } else {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| Error::Config(format!("cannot start {threads} threads: {e}")))?;
-        start = Instant::now();
-        pool.install(|| (0..height).into_par_iter().map(row).collect())
-    };
-    let seconds = start.elapsed().as_secs_f64();
+    let (rows, seconds) = crate::runner::timed_on(threads, || -> Vec<Vec<Vec<StratumSums>>> {
+        if threads == 1 {
+            (0..height).map(row).collect()
+        } else {
+            (0..height).into_par_iter().map(row).collect()
+        }
+    })?;
     let pixels = (width as usize) * (height as usize);
     let mut images: Vec<(Quantity, Vec<Estimate>)> = quantities
         .into_iter()

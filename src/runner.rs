@@ -138,6 +138,30 @@ fn run_batch<E: Estimator + ?Sized>(
     }
 }
 
+/// Runs `work` on `threads` worker threads and returns its result with its
+/// wall time in seconds. 0 and 1 run it on the calling thread, where rayon's
+/// global pool (all cores, built once per process) serves any parallel
+/// iterator inside (a caller that wants one thread iterates serially
+/// itself: no pool to build, a thread spawn per call saved); any other
+/// count builds a pool of its own, whose start is not timed.
+pub(crate) fn timed_on<T: Send>(
+    threads: usize,
+    work: impl FnOnce() -> T + Send,
+) -> Result<(T, f64), Error> {
+    if threads <= 1 {
+        let start = Instant::now();
+        let out = work();
+        return Ok((out, start.elapsed().as_secs_f64()));
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::Config(format!("cannot start {threads} threads: {e}")))?;
+    let start = Instant::now();
+    let out = pool.install(work);
+    Ok((out, start.elapsed().as_secs_f64()))
+}
+
 /// Samples `cfg.paths` paths of `est` and returns its estimates.
 ///
 /// Memory does not grow with `cfg.paths` (chunks run in batches of
@@ -158,21 +182,7 @@ pub fn run<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig) -> Result<RunResult,
             first = last;
         }
     };
-    let start;
-    if cfg.threads <= 1 {
-        // One thread, or all cores on rayon's global pool (built once per
-        // process).
-        start = Instant::now();
-        batches(&mut total);
-    } else {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(cfg.threads)
-            .build()
-            .map_err(|e| Error::Config(format!("cannot start {} threads: {e}", cfg.threads)))?;
-        start = Instant::now();
-        pool.install(|| batches(&mut total));
-    }
-    let seconds = start.elapsed().as_secs_f64();
+    let ((), seconds) = timed_on(cfg.threads, || batches(&mut total))?;
     Ok(RunResult {
         method: est.method(),
         estimates: quantities
