@@ -28,6 +28,23 @@ use serde::{Deserialize, Serialize};
 /// Largest image side accepted, in pixels.
 pub const MAX_SIDE: u32 = 8192;
 
+/// Why a camera's field of view (`fov_deg`, described as `what`) or image
+/// sides (`(name, pixels)`) cannot be, if they cannot: a field of view
+/// outside `(0, 170]` degrees, a side outside `1..=MAX_SIDE`. Flatland's
+/// line camera and the 3D camera share these bounds.
+pub fn view_problem(fov_deg: f64, what: &str, sides: &[(&str, u32)]) -> Option<String> {
+    if !(fov_deg > 0.0 && fov_deg <= 170.0) {
+        return Some(format!(
+            "camera fov_deg = {}: expected {what} in (0, 170]",
+            crate::error::Num(fov_deg)
+        ));
+    }
+    sides.iter().find_map(|&(name, n)| {
+        (n == 0 || n > MAX_SIDE)
+            .then(|| format!("camera {name} = {n}: expected 1 to {MAX_SIDE} pixels"))
+    })
+}
+
 /// A pinhole camera: file form `{ kind = "camera", position, look_at, up,
 /// fov_deg, width, height }`; `fov_deg` is the horizontal field of view
 /// (Mitsuba's default axis), pixels are square.
@@ -65,20 +82,11 @@ impl Camera {
         if up == DVec3::ZERO || f.normalize().cross(up).length() < 1e-6 {
             return Some("camera up is zero or along the view axis".into());
         }
-        if !(self.fov_deg > 0.0 && self.fov_deg <= 170.0) {
-            return Some(format!(
-                "camera fov_deg = {}: expected a horizontal field of view in (0, 170]",
-                crate::error::Num(self.fov_deg)
-            ));
-        }
-        for (name, n) in [("width", self.width), ("height", self.height)] {
-            if n == 0 || n > MAX_SIDE {
-                return Some(format!(
-                    "camera {name} = {n}: expected 1 to {MAX_SIDE} pixels"
-                ));
-            }
-        }
-        None
+        view_problem(
+            self.fov_deg,
+            "a horizontal field of view",
+            &[("width", self.width), ("height", self.height)],
+        )
     }
 
     /// The camera's frame and image plane.

@@ -392,17 +392,10 @@ fn check_sensor(
             width,
         } => {
             finite("camera position", position)?;
-            if !(fov_deg > 0.0 && fov_deg <= 170.0) {
-                return config(format!(
-                    "camera fov_deg = {}: expected a field of view in (0, 170]",
-                    Num(fov_deg)
-                ));
-            }
-            if width == 0 || width > crate::mesh::camera::MAX_SIDE {
-                return config(format!(
-                    "camera width = {width}: expected 1 to {} pixels",
-                    crate::mesh::camera::MAX_SIDE
-                ));
+            let view = [("width", width)];
+            if let Some(why) = crate::mesh::camera::view_problem(fov_deg, "a field of view", &view)
+            {
+                return config(why);
             }
             Sensor::Camera {
                 position,
