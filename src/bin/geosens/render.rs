@@ -66,11 +66,20 @@ fn file_name(name: &str) -> String {
         .collect()
 }
 
+/// The image of `size` (width, height) holding `data`.
+fn image_plane(size: (usize, usize), data: &[f64]) -> Plane<'_> {
+    Plane {
+        width: size.0,
+        height: size.1,
+        data,
+    }
+}
+
 /// Writes the images of `result` into `dir`; returns the files written.
 fn write_images(result: &ImageResult, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     std::fs::create_dir_all(dir)
         .map_err(|e| Error::Output(format!("cannot create {}: {e}", dir.display())))?;
-    let (w, h) = (result.width as usize, result.height as usize);
+    let size = (result.width as usize, result.height as usize);
     let mut written = Vec::new();
     for (q, img) in &result.images {
         let stem = match q {
@@ -81,54 +90,28 @@ fn write_images(result: &ImageResult, dir: &Path) -> Result<Vec<PathBuf>, Error>
         let mean: Vec<f64> = img.iter().map(|e| e.mean).collect();
         let stderr: Vec<f64> = img.iter().map(|e| e.stderr).collect();
         for (name, data) in [(stem.clone(), &mean), (format!("{stem}_stderr"), &stderr)] {
-            let plane = Plane {
-                width: w,
-                height: h,
-                data,
-            };
-            for ext in ["exr", "npy"] {
-                let path = dir.join(format!("{name}.{ext}"));
-                if ext == "exr" {
-                    write_exr(&path, &plane)?;
-                } else {
-                    write_npy(&path, &plane)?;
-                }
-                written.push(path);
-            }
+            let exr = dir.join(format!("{name}.exr"));
+            write_exr(&exr, &image_plane(size, data))?;
+            let npy = dir.join(format!("{name}.npy"));
+            write_npy(&npy, &image_plane(size, data))?;
+            written.extend([exr, npy]);
         }
         // The sensitivity on a diverging map (±scale), I and the error
         // images on a perceptual one (0 to scale); the scale in the name.
         let scale = robust_scale(&mean);
-        let png = |name: String| dir.join(name);
         let main = if matches!(q, Quantity::Intensity) {
-            let path = png(format!("{stem}_max{}.png", scale_tag(scale)));
-            let plane = Plane {
-                width: w,
-                height: h,
-                data: &mean,
-            };
-            write_png_magnitude(&path, &plane, scale)?;
+            let path = dir.join(format!("{stem}_max{}.png", scale_tag(scale)));
+            write_png_magnitude(&path, &image_plane(size, &mean), scale)?;
             path
         } else {
-            let path = png(format!("{stem}_pm{}.png", scale_tag(scale)));
-            let plane = Plane {
-                width: w,
-                height: h,
-                data: &mean,
-            };
-            write_png_diverging(&path, &plane, scale)?;
+            let path = dir.join(format!("{stem}_pm{}.png", scale_tag(scale)));
+            write_png_diverging(&path, &image_plane(size, &mean), scale)?;
             path
         };
-        written.push(main);
         let err_scale = robust_scale(&stderr);
-        let path = png(format!("{stem}_stderr_max{}.png", scale_tag(err_scale)));
-        let plane = Plane {
-            width: w,
-            height: h,
-            data: &stderr,
-        };
-        write_png_magnitude(&path, &plane, err_scale)?;
-        written.push(path);
+        let err = dir.join(format!("{stem}_stderr_max{}.png", scale_tag(err_scale)));
+        write_png_magnitude(&err, &image_plane(size, &stderr), err_scale)?;
+        written.extend([main, err]);
     }
     Ok(written)
 }
