@@ -218,6 +218,11 @@ pub struct Piece {
 pub struct PixelEdges {
     start: Vec<u32>,
     pieces: Vec<Piece>,
+    /// Per pixel, whether its pieces cross the image's rows more steeply
+    /// than its columns (their total vertical extent is at least their
+    /// horizontal one): the expectation method's warp at the camera then
+    /// slides along rows.
+    along_rows: Vec<bool>,
 }
 
 impl PixelEdges {
@@ -305,10 +310,30 @@ impl PixelEdges {
         for p in 0..pixels {
             start[p + 1] += start[p];
         }
+        let pieces: Vec<Piece> = cut.into_iter().map(|c| c.1).collect();
+        let along_rows = (0..pixels)
+            .map(|p| {
+                let own = &pieces[start[p] as usize..start[p + 1] as usize];
+                let (mut across_rows, mut across_columns) = (0.0, 0.0);
+                for c in own {
+                    across_rows += (c.b[1] - c.a[1]).abs();
+                    across_columns += (c.b[0] - c.a[0]).abs();
+                }
+                across_rows >= across_columns
+            })
+            .collect();
         PixelEdges {
             start,
-            pieces: cut.into_iter().map(|c| c.1).collect(),
+            pieces,
+            along_rows,
         }
+    }
+
+    /// Whether the warp at pixel `p` slides along the image's rows (else
+    /// along its columns); rows for a pixel without pieces.
+    #[inline]
+    pub fn along_rows(&self, p: u32) -> bool {
+        self.along_rows.get(p as usize).copied().unwrap_or(true)
     }
 
     /// The pieces inside pixel `p`.

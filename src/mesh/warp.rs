@@ -176,16 +176,12 @@ impl Space {
             // (pole on the camera's right axis) or its columns (pole up),
             // whichever the pixel's moving edges cross more steeply (a
             // crossing slides along its fibre at v_n / sin of the angle
-            // between edge and fibre). The stratum's sides across the
-            // fibres are the ends; the other two are fibres. See
+            // between edge and fibre; chosen once per pixel when its edges
+            // are cut, `PixelEdges::along_rows`). The stratum's sides
+            // across the fibres are the ends; the other two are fibres. See
             // `super::camera`.
-            let (mut across_rows, mut across_columns) = (0.0, 0.0);
-            for c in self.pixel_edges().of(pixel) {
-                across_rows += (c.b[1] - c.a[1]).abs();
-                across_columns += (c.b[0] - c.a[0]).abs();
-            }
             let [f, r, u] = frame;
-            let (pole, ends) = if across_rows >= across_columns {
+            let (pole, ends) = if self.pixel_edges().along_rows(pixel) {
                 (r, [u.cross(f + r * rect[0]), u.cross(f + r * rect[1])])
             } else {
                 (u, [r.cross(f + u * rect[2]), r.cross(f + u * rect[3])])
