@@ -23,6 +23,10 @@ pub enum Error {
     /// its file cannot be read.
     #[error("invalid scene: {0}")]
     Scene(String),
+    /// States of shards that do not make one whole run, or a file that is
+    /// not a state.
+    #[error("cannot merge: {0}")]
+    Merge(String),
     /// Writing a result (figure, table) failed.
     #[error("{0}")]
     Output(String),

@@ -10,11 +10,11 @@
 use crate::path::PixelSample;
 use crate::rng::PathRng;
 use crate::stats::{ChunkSums, StratumSums};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// What one weight slot estimates.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(tag = "kind", content = "name", rename_all = "snake_case")]
 pub enum Quantity {
     /// The intensity `I` at the probe.

@@ -82,6 +82,7 @@ pub fn render(
             "spp = {spp}: expected 2 to 2^32 paths per pixel (an error bar needs two)"
         )));
     }
+    crate::runner::check_threads(threads)?;
     let quantities = est.quantities();
     let nq = quantities.len();
     let done = std::sync::atomic::AtomicU64::new(0);

@@ -56,14 +56,17 @@ mod figures_common;
 pub mod flat;
 pub mod image;
 pub mod image_io;
+pub mod job;
 pub mod mesh;
 pub mod method;
 pub mod path;
 #[cfg(feature = "figures")]
 pub mod plot;
+pub mod report;
 pub mod rng;
 pub mod rod;
 pub mod runner;
+pub mod shard;
 pub mod stats;
 
 pub use error::Error;

@@ -4,12 +4,18 @@
 //! serially. The result is therefore bit-identical for any thread count
 //! (rayon's own float reductions are not: rayon-rs/rayon#663).
 //!
-//! Chunks run in batches of [`BATCH`]: a batch's moments are collected,
-//! merged into the running total in chunk order, and dropped before the next
-//! batch starts. Memory is one batch's moments whatever the path count, and
-//! the merge order (every chunk in turn, from the first) is the one a single
-//! serial fold over all chunks would follow, so the batch size changes no
-//! bit of the result.
+//! The reduction is two-level, and fixed: the chunks of a *block* of
+//! [`BLOCK`] chunks are merged in chunk order into the block's moments, and
+//! the blocks' moments in block order into the run's. A shard of a run
+//! ([`crate::shard`]) samples whole blocks and keeps their moments, so
+//! merging the shards' blocks in order repeats the single run's reduction,
+//! bit for bit.
+//!
+//! Chunks run in batches of [`BATCH`]: a batch's chunk moments are
+//! collected, merged into its blocks and the blocks into the running total,
+//! then dropped before the next batch starts. Memory is one batch's moments
+//! whatever the path count, and the batch size changes no bit of the
+//! result.
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::rng;
@@ -21,8 +27,12 @@ use std::time::Instant;
 /// Paths per chunk. Part of what a seed means: changing it changes results.
 pub const CHUNK: u64 = 4096;
 
-/// Chunks per batch (4.2 million paths): enough to keep every core busy
-/// between the batch's merges (a core idles at most one chunk per batch),
+/// Chunks per block (65 536 paths), the unit a run is sharded by. Part of
+/// what a seed means (it fixes the order of the merges).
+pub const BLOCK: u64 = 16;
+
+/// Chunks per batch, a multiple of [`BLOCK`] (4.2 million paths): enough
+/// to keep every core busy between the batch's merges (a core idles at most one chunk per batch),
 /// few enough that a batch's moments stay small (64 bytes per quantity and
 /// chunk: 256 KiB for the rod's 4 quantities, 17 MB for a scene with 253
 /// parameters). Not part of what a seed means: any batch size gives the
@@ -33,6 +43,10 @@ pub const BATCH: u64 = 1024;
 /// count is exact as an `f64` (the moments' merge weighs chunks by their
 /// counts in `f64`). At 10⁸ paths a second it would take three years.
 pub const MAX_PATHS: u64 = 1 << 53;
+
+/// Most worker threads a run accepts: beyond it a pool would cost more to
+/// start than the runs it serves (and rayon itself stops at 65535).
+pub const MAX_THREADS: usize = 1024;
 
 /// How many paths to sample, from which seed, on how many threads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -85,6 +99,23 @@ impl RunResult {
     }
 }
 
+/// Errors unless `threads ≤ MAX_THREADS`.
+pub(crate) fn check_threads(threads: usize) -> Result<(), Error> {
+    if threads > MAX_THREADS {
+        return Err(Error::Config(format!(
+            "threads = {threads}: expected 0 (all cores) to {MAX_THREADS}"
+        )));
+    }
+    Ok(())
+}
+
+/// Errors unless `2 ≤ cfg.paths ≤ MAX_PATHS` and `cfg.threads ≤
+/// MAX_THREADS`.
+fn check_config(cfg: &RunConfig) -> Result<(), Error> {
+    check_threads(cfg.threads)?;
+    check_paths(cfg.paths)
+}
+
 /// Errors unless `2 ≤ paths ≤ MAX_PATHS`.
 fn check_paths(paths: u64) -> Result<(), Error> {
     if paths < 2 {
@@ -113,28 +144,79 @@ fn run_chunk<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig, nq: usize, c: u64)
     sums.iter().map(ChunkSums::moments).collect()
 }
 
-/// Merges the moments of chunks `chunks` into `total`, in chunk order; the
-/// chunks run in parallel on the current rayon pool unless `serial`.
-fn run_batch<E: Estimator + ?Sized>(
+/// Number of blocks of a run of `paths` paths (the last may be partial).
+pub fn blocks(paths: u64) -> u64 {
+    paths.div_ceil(CHUNK).div_ceil(BLOCK)
+}
+
+/// The moments of blocks `blocks`, each its chunks' moments merged in chunk
+/// order, handed to `sink` in block order; the chunks of a batch run in
+/// parallel on the current rayon pool unless `serial`.
+fn run_blocks<E: Estimator + ?Sized>(
     est: &E,
     cfg: &RunConfig,
-    chunks: std::ops::Range<u64>,
+    blocks: std::ops::Range<u64>,
     serial: bool,
-    total: &mut [Moments],
+    sink: &mut impl FnMut(Vec<Moments>),
 ) {
-    let nq = total.len();
-    let per_chunk: Vec<Vec<Moments>> = if serial {
-        chunks.map(|c| run_chunk(est, cfg, nq, c)).collect()
-    } else {
-        chunks
-            .into_par_iter()
-            .map(|c| run_chunk(est, cfg, nq, c))
-            .collect()
-    };
-    for chunk in &per_chunk {
-        for (t, m) in total.iter_mut().zip(chunk) {
-            *t = t.merge(m);
+    let nq = est.quantities().len();
+    let chunks = cfg.paths.div_ceil(CHUNK);
+    let per_batch = BATCH / BLOCK;
+    let mut first = blocks.start;
+    while first < blocks.end {
+        let last = blocks.end.min(first + per_batch);
+        let range = first * BLOCK..chunks.min(last * BLOCK);
+        let per_chunk: Vec<Vec<Moments>> = if serial {
+            range.map(|c| run_chunk(est, cfg, nq, c)).collect()
+        } else {
+            range
+                .into_par_iter()
+                .map(|c| run_chunk(est, cfg, nq, c))
+                .collect()
+        };
+        for block in per_chunk.chunks(BLOCK as usize) {
+            let mut total = vec![Moments::default(); nq];
+            for chunk in block {
+                merge_into(&mut total, chunk);
+            }
+            sink(total);
         }
+        first = last;
+    }
+}
+
+/// Samples blocks `blocks` of the run `cfg` of `est` on `cfg.threads`
+/// threads; returns every block's moments in block order and the wall time.
+/// The runner's own [`run`] is this over every block followed by
+/// [`fold_blocks`]: a shard of a run ([`crate::shard`]) calls it on its
+/// share.
+pub fn sample_blocks<E: Estimator + ?Sized>(
+    est: &E,
+    cfg: &RunConfig,
+    blocks: std::ops::Range<u64>,
+) -> Result<(Vec<Vec<Moments>>, f64), Error> {
+    check_config(cfg)?;
+    let mut out = Vec::new();
+    let ((), seconds) = timed_on(cfg.threads, || {
+        run_blocks(est, cfg, blocks, cfg.threads == 1, &mut |b| out.push(b))
+    })?;
+    Ok((out, seconds))
+}
+
+/// Merges block moments (each a slice of per-quantity moments) in the
+/// order given into one total per quantity: the runner's reduction.
+pub fn fold_blocks<'a>(nq: usize, blocks: impl IntoIterator<Item = &'a [Moments]>) -> Vec<Moments> {
+    let mut total = vec![Moments::default(); nq];
+    for block in blocks {
+        merge_into(&mut total, block);
+    }
+    total
+}
+
+/// `total[q] ← total[q] ⊕ block[q]` for every quantity `q`.
+fn merge_into(total: &mut [Moments], block: &[Moments]) {
+    for (t, m) in total.iter_mut().zip(block) {
+        *t = t.merge(m);
     }
 }
 
@@ -168,21 +250,16 @@ pub(crate) fn timed_on<T: Send>(
 /// [`BATCH`]); a run of [`MAX_PATHS`] starts like any other and runs until
 /// interrupted.
 pub fn run<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig) -> Result<RunResult, Error> {
-    check_paths(cfg.paths)?;
+    check_config(cfg)?;
     let quantities = est.quantities();
     let mut total = vec![Moments::default(); quantities.len()];
-    let chunks = cfg.paths.div_ceil(CHUNK);
-    let batches = |total: &mut [Moments]| {
-        let mut first = 0;
-        while first < chunks {
-            let last = chunks.min(first + BATCH);
-            // One thread: no pool to build (a thread spawn per call), same
-            // chunks in the same order, so the same bits.
-            run_batch(est, cfg, first..last, cfg.threads == 1, total);
-            first = last;
-        }
-    };
-    let ((), seconds) = timed_on(cfg.threads, || batches(&mut total))?;
+    let ((), seconds) = timed_on(cfg.threads, || {
+        // One thread: no pool to build (a thread spawn per call), same
+        // chunks in the same order, so the same bits.
+        run_blocks(est, cfg, 0..blocks(cfg.paths), cfg.threads == 1, &mut |b| {
+            merge_into(&mut total, &b)
+        })
+    })?;
     Ok(RunResult {
         method: est.method(),
         estimates: quantities

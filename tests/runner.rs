@@ -4,7 +4,7 @@
 //! refused with a message.
 use geosens::estimator::{Estimator, Quantity};
 use geosens::rng::{self, PathRng};
-use geosens::runner::{CHUNK, RunConfig, run};
+use geosens::runner::{BLOCK, CHUNK, RunConfig, run};
 use geosens::stats::{ChunkSums, Moments};
 use rand::Rng;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -36,16 +36,24 @@ impl Estimator for Cheap {
 }
 
 /// The runner's contract, written out: chunk `c` of `CHUNK` paths from
-/// `rng::stream(seed, c)`, moments merged serially in chunk order.
+/// `rng::stream(seed, c)`; the moments of each block of `BLOCK` chunks
+/// merged serially in chunk order, then the blocks' in block order.
 fn serial_reference(est: &impl Estimator, paths: u64, seed: u64) -> Vec<Moments> {
     let nq = est.quantities().len();
     let mut total = vec![Moments::default(); nq];
-    for c in 0..paths.div_ceil(CHUNK) {
-        let mut rng = rng::stream(seed, c);
-        let mut sums = vec![ChunkSums::default(); nq];
-        est.accumulate(&mut rng, CHUNK.min(paths - c * CHUNK), &mut sums);
-        for (t, s) in total.iter_mut().zip(&sums) {
-            *t = t.merge(&s.moments());
+    let chunks = paths.div_ceil(CHUNK);
+    for b in 0..chunks.div_ceil(BLOCK) {
+        let mut block = vec![Moments::default(); nq];
+        for c in b * BLOCK..chunks.min((b + 1) * BLOCK) {
+            let mut rng = rng::stream(seed, c);
+            let mut sums = vec![ChunkSums::default(); nq];
+            est.accumulate(&mut rng, CHUNK.min(paths - c * CHUNK), &mut sums);
+            for (t, s) in block.iter_mut().zip(&sums) {
+                *t = t.merge(&s.moments());
+            }
+        }
+        for (t, m) in total.iter_mut().zip(&block) {
+            *t = t.merge(m);
         }
     }
     total
@@ -53,7 +61,8 @@ fn serial_reference(est: &impl Estimator, paths: u64, seed: u64) -> Vec<Moments>
 
 #[test]
 fn batches_merge_in_chunk_order_for_any_thread_count() {
-    // Two and a half batches of 1024 chunks, plus a partial last chunk.
+    // Two and a half batches of 1024 chunks, plus a partial last chunk (so
+    // a partial last block too).
     let paths = 2 * 1024 * CHUNK + 512 * CHUNK + 77;
     let reference: Vec<_> = serial_reference(&Cheap, paths, 5)
         .iter()

@@ -82,17 +82,23 @@ pub fn dimension(path: &Path) -> Result<usize, Error> {
     fn from_json_text(text: &str) -> Result<serde_json::Value, Error> {
         serde_json::from_str(text).map_err(|e| json_error(text, &e))
     }
-    let value = parse_file(path, as_json, from_json_text)?;
+    Ok(dimension_of(&parse_file(path, as_json, from_json_text)?))
+}
+
+/// The dimension of a scene given as the file's schema in JSON (a parsed
+/// file, or a Python dict): 2 if its sensor's point has two coordinates,
+/// else 3.
+pub fn dimension_of(value: &serde_json::Value) -> usize {
     let sensor = &value["sensor"];
     let point = if sensor["point"].is_array() {
         &sensor["point"]
     } else {
         &sensor["position"]
     };
-    Ok(match point.as_array() {
+    match point.as_array() {
         Some(a) if a.len() == 2 => 2,
         _ => 3,
-    })
+    }
 }
 
 /// `e` with the file `path` named in its message (scene errors only).

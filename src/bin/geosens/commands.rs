@@ -1,89 +1,114 @@
 //! The subcommands: `rod`, `compare` and `flat`, each printing a table or
 //! one JSON line.
-use super::output::{FlatJsonLine, JsonLine, MeanErr, all_finite, caveat_of, z_text};
 use super::*;
+use geosens::report::{yes_no, z_text};
 
 /// `geosens rod`.
 pub(super) fn rod_command(
     args: &RodArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let rod = Rod::new(args.ks, args.ke, args.length)?;
-    let probe = Probe::new(&rod, args.x, Direction::from_sign(args.omega)?)?;
-    let cfg = args.run.config(1_000_000)?;
-    let result = match args.method.0 {
-        Some(m) => run(args.fd.estimator(m, (rod, probe), None)?.as_ref(), &cfg)?,
-        None if args.fd.fd_step.is_some() => {
-            return Err(Error::Config(
-                "--fd-step sets the half step of --method fd, not of exact".into(),
-            )
+    let job = Job {
+        target: Target::Rod {
+            ks: args.ks,
+            ke: args.ke,
+            length: args.length,
+            x: args.x,
+            omega: args.omega,
+        },
+        method: args.method.0,
+        fd_step: args.fd.fd_step,
+    };
+    estimate(&job, &args.run, &args.shard, args.json, out)
+}
+
+/// Runs `job` (or its shard, with `--state`) and prints its report.
+fn estimate(
+    job: &Job,
+    run: &RunArgs,
+    shard: &ShardArgs,
+    json: bool,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let cfg = run.config(1_000_000)?;
+    let Some(path) = &shard.state else {
+        if let Some(s) = shard.shard {
+            return Err(Error::Config(format!(
+                "--shard {s} needs --state FILE, where the shard's state goes"
+            ))
             .into());
         }
-        None => exact_result(&rod, &probe),
+        return print_report(&job.run(&cfg)?, json, out);
     };
-    all_finite(&result)?;
-    if args.json {
-        let [i, s, g] = quantities().map(|q| result.get(&q).map(|e| MeanErr::of(&e, None)));
-        let line = JsonLine {
-            method: result.method,
-            intensity: i,
-            sensitivity: s,
-            gradient_x: g,
-            paths: result.paths,
-            seconds: result.seconds,
-        };
-        writeln!(out, "{}", serde_json::to_string(&line)?)?;
-        return Ok(());
+    if json {
+        return Err(Error::Config(
+            "--state writes the shard's state, not a result: `geosens merge --json` prints it"
+                .into(),
+        )
+        .into());
     }
-    writeln!(
-        out,
-        "rod κs = {:?}, κe = {:?}, length {:?}; probe x = {:?}, ω = {:+}",
-        rod.ks,
-        rod.ke,
-        rod.length,
-        probe.x,
-        probe.omega.sign()
-    )?;
-    writeln!(
-        out,
-        "method {}: {} paths, seed {}, {:.3} s",
-        result.method, result.paths, cfg.seed, result.seconds
-    )?;
-    writeln!(
-        out,
-        "{:<12} {:>14} {:>11} {:>9} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
-        "quantity", "mean", "stderr", "n", "nonzero", "vov", "max_share", "reliable", "exact", "z"
-    )?;
-    let exact = exact_values(&rod, &probe);
-    for (q, e) in &result.estimates {
-        let ex = exact[slot(q)];
-        let mc = e.n > 0;
-        writeln!(
-            out,
-            "{:<12} {:>14.6e} {:>11.2e} {:>9} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
-            q.to_string(),
-            e.mean,
-            e.stderr,
-            e.n,
-            dash(mc, || e.nonzero.to_string()),
-            dash(mc, || format!("{:.1e}", e.vov)),
-            dash(mc, || format!("{:.1e}", e.max_share)),
-            dash(mc, || yes_no(e.is_reliable()).to_owned()),
-            dash(mc, || format!("{ex:.6e}")),
-            dash(mc, || z_text(e, ex)),
-        )?;
-    }
+    let which = shard.shard.unwrap_or(Shard::WHOLE);
+    let state = job.run_shard(&cfg, which)?;
+    write_state(path, &state)?;
+    eprintln!(
+        "wrote shard {which} ({} of {} paths, {:.2} s) to {}",
+        state.paths,
+        state.run.paths,
+        state.seconds,
+        path.display()
+    );
     Ok(())
 }
 
-/// `text()` if `show`, else `-`.
-fn dash(show: bool, text: impl FnOnce() -> String) -> String {
-    if show { text() } else { "-".to_owned() }
+/// Writes `state` to `path` (through a temporary file beside it, so that a
+/// killed shard leaves no half-written state).
+fn write_state(path: &std::path::Path, state: &State) -> Result<(), Error> {
+    let cannot = |e: std::io::Error| Error::Output(format!("cannot write {}: {e}", path.display()));
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".part");
+    let tmp = std::path::PathBuf::from(tmp);
+    std::fs::write(&tmp, state.to_json()? + "\n").map_err(cannot)?;
+    std::fs::rename(&tmp, path).map_err(cannot)
 }
 
-/// `yes` or `no`.
-fn yes_no(b: bool) -> &'static str {
-    if b { "yes" } else { "no" }
+/// Prints `report`: its warnings on stderr, its JSON line or table on `out`.
+fn print_report(
+    report: &Report,
+    json: bool,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let text = if json {
+        report.json()? + "\n"
+    } else {
+        report.table()?
+    };
+    for w in report.warnings() {
+        eprintln!("{w}");
+    }
+    out.write_all(text.as_bytes())?;
+    Ok(())
+}
+
+/// `geosens merge`.
+pub(super) fn merge_command(
+    args: &MergeArgs,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut states = Vec::with_capacity(args.states.len());
+    for path in &args.states {
+        let name = path.display().to_string();
+        let state = std::fs::read_to_string(path)
+            .map_err(|e| Error::Merge(format!("cannot read {name}: {e}")))
+            .and_then(|text| State::from_json(&text))
+            .map_err(|e| match e {
+                Error::Merge(m) if !m.starts_with("cannot read") => {
+                    Error::Merge(format!("{name}: {m}"))
+                }
+                other => other,
+            })?;
+        states.push((name, state));
+    }
+    print_report(&geosens::shard::merge(&states)?, args.json, out)
 }
 
 /// The paper's rods: name, κs, κe (length 2).
@@ -163,9 +188,9 @@ pub(super) fn compare_command(
         for x in XS {
             for omega in [Direction::Right, Direction::Left] {
                 let probe = Probe::new(&rod, x, omega)?;
-                let ex = exact_values(&rod, &probe);
+                let ex = geosens::report::rod_exact(&rod, &probe);
                 let label = format!("{x}, {:+}", omega.sign());
-                writeln!(out, "{}", row(&label, &exact_result(&rod, &probe), &ex))?;
+                writeln!(out, "{}", row(&label, &exact_result(&rod, &probe)?, &ex))?;
                 for (m, total) in Method::UNBIASED.iter().zip(&mut totals) {
                     let r = run(m.estimator((rod, probe))?.as_ref(), &cfg)?;
                     writeln!(out, "{}", row("", &r, &ex))?;
@@ -339,29 +364,11 @@ pub(super) fn flat_command(
     args: &SceneArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    check_dimension(&args.scene, 2)?;
-    let scene = std::sync::Arc::new(geosens::flat::file::load(&args.scene)?);
-    let (shapes, parameters) = (scene.shapes().len(), scene.parameters().len());
-    scene_command(args, scene, shapes, parameters, out)
-}
-
-/// Errors if the scene file at `path` is of the other dimension than
-/// `want` (its sensor's point tells): the loader's own message would be
-/// about a field, not the subcommand.
-fn check_dimension(path: &std::path::Path, want: usize) -> Result<(), Error> {
-    let got = geosens::flat::file::dimension(path)?;
-    if got == want {
-        return Ok(());
-    }
-    let (is, use_) = if got == 2 {
-        ("a flatland (2D) scene file", "geosens flat")
-    } else {
-        ("a 3D scene file", "geosens mesh")
-    };
-    Err(Error::Scene(format!(
-        "{}: this is {is} (its sensor's point has {got} coordinates): use `{use_}`",
-        path.display()
-    )))
+    scene_command(
+        args,
+        Target::Flat(SceneSource::File(args.scene.clone())),
+        out,
+    )
 }
 
 /// `geosens mesh`.
@@ -369,99 +376,23 @@ pub(super) fn mesh_command(
     args: &SceneArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    check_dimension(&args.scene, 3)?;
-    let scene = std::sync::Arc::new(geosens::mesh::file::load(&args.scene)?);
-    let (shapes, parameters) = (scene.shapes().len(), scene.parameters().len());
-    scene_command(args, scene, shapes, parameters, out)
+    scene_command(
+        args,
+        Target::Mesh(SceneSource::File(args.scene.clone())),
+        out,
+    )
 }
 
-/// A run of `args.method` on a scene loaded from `args.scene` (`shapes`
-/// shapes, `parameters` parameters): a table or one JSON line.
+/// A run of `args.method` on a scene file: a table or one JSON line.
 fn scene_command(
     args: &SceneArgs,
-    problem: impl Problem,
-    shapes: usize,
-    parameters: usize,
+    target: Target,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let cfg = args.run.config(1_000_000)?;
-    let estimator = args.fd.estimator(args.method, problem, Some(&args.scene))?;
-    if estimator.image().is_some() {
-        return Err(Error::Config(format!(
-            "{}: the sensor is a camera: its images come from `geosens render`",
-            args.scene.display()
-        ))
-        .into());
-    }
-    let result = run(estimator.as_ref(), &cfg)?;
-    all_finite(&result)?;
-    let caveats = estimator.caveats();
-    for (q, why) in &caveats {
-        eprintln!("warning: {q}: {why}");
-    }
-    if args.json {
-        let value = |q: &Quantity, e: &Estimate| {
-            serde_json::to_value(MeanErr::of(e, caveat_of(&caveats, q)))
-        };
-        let mut intensity = None;
-        let mut sensitivity = serde_json::Map::new();
-        let mut gradient = serde_json::Map::new();
-        for (q, e) in &result.estimates {
-            match q {
-                Quantity::Intensity => intensity = Some(MeanErr::of(e, caveat_of(&caveats, q))),
-                Quantity::Sensitivity(p) => {
-                    sensitivity.insert(p.clone(), value(q, e)?);
-                }
-                Quantity::Gradient(a) => {
-                    gradient.insert(a.clone(), value(q, e)?);
-                }
-            }
-        }
-        let line = FlatJsonLine {
-            method: result.method,
-            intensity: intensity.ok_or("no intensity estimate")?,
-            sensitivity,
-            gradient: (!gradient.is_empty()).then_some(gradient),
-            paths: result.paths,
-            seconds: result.seconds,
-        };
-        writeln!(out, "{}", serde_json::to_string(&line)?)?;
-        return Ok(());
-    }
-    writeln!(
-        out,
-        "scene {}: {} shapes, {} parameters",
-        args.scene.display(),
-        shapes,
-        parameters
-    )?;
-    writeln!(
-        out,
-        "method {}: {} paths, seed {}, {:.3} s",
-        result.method, result.paths, cfg.seed, result.seconds
-    )?;
-    writeln!(
-        out,
-        "{:<20} {:>14} {:>11} {:>9} {:>9} {:>9} {:>8}",
-        "quantity", "mean", "stderr", "nonzero", "vov", "max_share", "reliable"
-    )?;
-    for (q, e) in &result.estimates {
-        let caveat = caveat_of(&caveats, q);
-        writeln!(
-            out,
-            "{:<20} {:>14.6e} {:>11.2e} {:>9} {:>9.1e} {:>9.1e} {:>8}",
-            q.to_string(),
-            e.mean,
-            e.stderr,
-            e.nonzero,
-            e.vov,
-            e.max_share,
-            match (e.is_reliable(), caveat) {
-                (true, None) => "yes",
-                (_, Some(_)) => "caveat",
-                (false, None) => "no",
-            }
-        )?;
-    }
-    Ok(())
+    let job = Job {
+        target,
+        method: Some(args.method),
+        fd_step: args.fd.fd_step,
+    };
+    estimate(&job, &args.run, &args.shard, args.json, out)
 }

@@ -22,10 +22,11 @@
 //! parse errors exit with status 2).
 use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use geosens::error::Num;
-use geosens::rod::{Direction, Probe, Rod, exact};
-use geosens::{Error, Estimate, Estimator, Method, Problem, Quantity, RunConfig, RunResult, run};
-use serde::Serialize;
+use geosens::job::{Job, SceneSource, Target};
+use geosens::report::{Header, Report};
+use geosens::rod::{Direction, Probe, Rod};
+use geosens::shard::{Shard, State};
+use geosens::{Error, Estimate, Method, Quantity, RunConfig, RunResult, run};
 use std::io::{self, Write};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -60,6 +61,34 @@ enum Command {
     /// Render a 3D scene's camera: images of I and of every ∂I/∂π with their
     /// standard-error images (EXR, .npy, PNG) and one JSON line.
     Render(render::RenderArgs),
+    /// Merge the states of every shard of one run (`--shard I/N --state
+    /// FILE`) and print what the single run prints.
+    Merge(MergeArgs),
+}
+
+/// `--shard I/N --state FILE`, shared by the estimation commands.
+#[derive(Debug, Args)]
+struct ShardArgs {
+    /// Run only shard I of N of the run (1 ≤ I ≤ N; the run's blocks of
+    /// 65536 paths split into N contiguous shares); needs `--state`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
+    /// Write the shard's exact accumulator state to FILE (JSON) instead of
+    /// printing a result; `geosens merge` prints the run from all states.
+    /// Without `--shard`, the whole run is one shard (1/1).
+    #[arg(long, value_name = "FILE")]
+    state: Option<std::path::PathBuf>,
+}
+
+/// `geosens merge`: the states of one run.
+#[derive(Debug, Args)]
+struct MergeArgs {
+    /// The state files, one per shard, in any order.
+    #[arg(required = true, value_name = "FILE")]
+    states: Vec<std::path::PathBuf>,
+    /// Print one JSON line instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 /// `geosens flat` and `geosens mesh`: a scene file, a method, a run.
@@ -77,6 +106,9 @@ struct SceneArgs {
     /// The run configuration.
     #[command(flatten)]
     run: RunArgs,
+    /// Sharding.
+    #[command(flatten)]
+    shard: ShardArgs,
     /// Print one JSON line instead of a table.
     #[arg(long)]
     json: bool,
@@ -90,37 +122,6 @@ struct FdArgs {
     /// change for a scale; in (0, 1) [default: 0.001].
     #[arg(long, allow_hyphen_values = true)]
     fd_step: Option<f64>,
-}
-
-impl FdArgs {
-    /// `method`'s estimator on `problem`, with `--fd-step` for `fd`. An
-    /// invalid displaced scene's error (`path`: its file, if any) gets a hint.
-    fn estimator(
-        &self,
-        method: Method,
-        problem: impl Problem,
-        path: Option<&std::path::Path>,
-    ) -> Result<Box<dyn Estimator>, Error> {
-        if self.fd_step.is_some() && method != Method::Fd {
-            return Err(Error::Config(format!(
-                "--fd-step sets the half step of --method fd, not of {method}"
-            )));
-        }
-        problem
-            .estimator(method, self.fd_step)
-            .map_err(|e| match e {
-                Error::Scene(msg) => {
-                    let file = path.map_or(String::new(), |p| format!("{}: ", p.display()));
-                    let hint = if msg.contains("displaced by") {
-                        "; try a smaller --fd-step"
-                    } else {
-                        ""
-                    };
-                    Error::Scene(format!("{file}{msg}{hint}"))
-                }
-                other => other,
-            })
-    }
 }
 
 /// How to estimate: the method, the rod, the probe and the run. Float values
@@ -153,6 +154,9 @@ struct RodArgs {
     /// The run configuration.
     #[command(flatten)]
     run: RunArgs,
+    /// Sharding.
+    #[command(flatten)]
+    shard: ShardArgs,
     /// Print one JSON line instead of a table.
     #[arg(long)]
     json: bool,
@@ -236,11 +240,7 @@ impl ValueEnum for RodMethod {
 
 /// The three quantities a rod run can report, in table and JSON order.
 fn quantities() -> [Quantity; 3] {
-    [
-        Quantity::Intensity,
-        Quantity::sensitivity(geosens::rod::PARAMETER),
-        Quantity::gradient("x"),
-    ]
+    geosens::report::rod_quantities()
 }
 
 /// Position of `q` in [`quantities`].
@@ -252,31 +252,24 @@ fn slot(q: &Quantity) -> usize {
     }
 }
 
-/// The exact values of [`quantities`] at a probe.
-fn exact_values(rod: &Rod, probe: &Probe) -> [f64; 3] {
-    let e = exact::solve(rod, probe.x, probe.omega);
-    [e.intensity, e.sensitivity, e.gradient_x]
+/// The header of a rod probe.
+fn rod_header(rod: &Rod, probe: &Probe) -> Header {
+    Header::Rod {
+        ks: rod.ks,
+        ke: rod.ke,
+        length: rod.length,
+        x: probe.x,
+        omega: probe.omega.sign(),
+    }
 }
 
 /// The exact solution as a [`RunResult`] (stderr 0, `paths` 0: nothing is
 /// sampled; `seconds` is the time of the evaluation).
-fn exact_result(rod: &Rod, probe: &Probe) -> RunResult {
-    let start = Instant::now();
-    let values = exact_values(rod, probe);
-    let seconds = start.elapsed().as_secs_f64();
-    RunResult {
-        method: "exact",
-        estimates: quantities()
-            .into_iter()
-            .zip(values.map(Estimate::exact))
-            .collect(),
-        paths: 0,
-        seconds,
-    }
+fn exact_result(rod: &Rod, probe: &Probe) -> Result<RunResult, Error> {
+    geosens::job::exact_result(&rod_header(rod, probe))
 }
 
 mod commands;
-mod output;
 mod render;
 
 fn main() -> ExitCode {
@@ -288,6 +281,7 @@ fn main() -> ExitCode {
         Command::Flat(args) => commands::flat_command(args, &mut out),
         Command::Mesh(args) => commands::mesh_command(args, &mut out),
         Command::Render(args) => render::render_command(args, &mut out),
+        Command::Merge(args) => commands::merge_command(args, &mut out),
     };
     match result.and_then(|()| Ok(out.flush()?)) {
         Ok(()) => ExitCode::SUCCESS,

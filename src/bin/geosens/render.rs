@@ -4,12 +4,13 @@
 //! images, a diverging map centred on 0 for each sensitivity, the scale in
 //! the file name), and one JSON line whose means are the images' mean
 //! pixel values.
-use super::output::{MeanErr, caveat_of};
 use super::*;
 use geosens::image::{ImageResult, render};
 use geosens::image_io::{
     Plane, robust_scale, scale_tag, write_exr, write_npy, write_png_diverging, write_png_magnitude,
 };
+use geosens::job::SceneSource;
+use geosens::job::{ImageReport, RenderJob};
 use std::path::{Path, PathBuf};
 
 /// `geosens render`: a camera scene, a method, paths per pixel, a folder.
@@ -37,19 +38,6 @@ pub(super) struct RenderArgs {
     /// Worker threads, 0 = all cores (images do not depend on it).
     #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     threads: usize,
-}
-
-/// The JSON line of `geosens render`.
-#[derive(Serialize)]
-struct RenderJsonLine<'a> {
-    method: &'a str,
-    #[serde(rename = "I")]
-    intensity: MeanErr,
-    sensitivity: serde_json::Map<String, serde_json::Value>,
-    width: u32,
-    height: u32,
-    paths: u64,
-    seconds: f64,
 }
 
 /// A parameter name as a file name: letters, digits, `-` and `_` kept,
@@ -128,14 +116,12 @@ pub(super) fn render_command(
         ))
         .into());
     }
-    let path = Some(args.scene.as_path());
-    let estimator = if geosens::flat::file::dimension(&args.scene)? == 2 {
-        let scene = std::sync::Arc::new(geosens::flat::file::load(&args.scene)?);
-        args.fd.estimator(args.method, scene, path)?
-    } else {
-        let scene = std::sync::Arc::new(geosens::mesh::file::load(&args.scene)?);
-        args.fd.estimator(args.method, scene, path)?
+    let job = RenderJob {
+        scene: SceneSource::File(args.scene.clone()),
+        method: args.method,
+        fd_step: args.fd.fd_step,
     };
+    let (estimator, _) = job.prepare()?;
     let rows = estimator.image().map_or(0, |(_, h)| h);
     let bar = indicatif::ProgressBar::new(u64::from(rows));
     bar.set_style(
@@ -152,20 +138,16 @@ pub(super) fn render_command(
         &|done| bar.set_position(done),
     );
     bar.finish_and_clear();
-    let result = result?;
-    let caveats = estimator.caveats();
-    for (q, why) in &caveats {
-        eprintln!("warning: {q}: {why}");
+    let report = ImageReport {
+        result: result?,
+        caveats: estimator.caveats(),
+    };
+    let text = report.json()? + "\n";
+    for w in report.warnings() {
+        eprintln!("{w}");
     }
-    for (q, img) in &result.images {
-        if img
-            .iter()
-            .any(|e| !e.mean.is_finite() || !e.stderr.is_finite())
-        {
-            eprintln!("warning: {q}: some pixels are not finite (overflow)");
-        }
-    }
-    let written = write_images(&result, &args.out)?;
+    let result = &report.result;
+    let written = write_images(result, &args.out)?;
     eprintln!(
         "wrote {} files to {} ({}×{} pixels, {} paths per pixel, {:.2} s)",
         written.len(),
@@ -175,27 +157,6 @@ pub(super) fn render_command(
         result.spp,
         result.seconds
     );
-    let mut intensity = None;
-    let mut sensitivity = serde_json::Map::new();
-    for ((q, _), e) in result.images.iter().zip(&result.means) {
-        let m = MeanErr::of(e, caveat_of(&caveats, q));
-        match q {
-            Quantity::Intensity => intensity = Some(m),
-            Quantity::Sensitivity(p) => {
-                sensitivity.insert(p.clone(), serde_json::to_value(m)?);
-            }
-            Quantity::Gradient(_) => {}
-        }
-    }
-    let line = RenderJsonLine {
-        method: result.method,
-        intensity: intensity.ok_or("no intensity image")?,
-        sensitivity,
-        width: result.width,
-        height: result.height,
-        paths: result.paths(),
-        seconds: result.seconds,
-    };
-    writeln!(out, "{}", serde_json::to_string(&line)?)?;
+    out.write_all(text.as_bytes())?;
     Ok(())
 }

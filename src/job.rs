@@ -1,0 +1,478 @@
+//! One estimation as data: what `geosens rod`, `geosens flat` and `geosens
+//! mesh` run ([`Job`]): the rod and probe or the scene, the method, the
+//! finite differences' step. The command line, the Python package and the
+//! shards of a run ([`crate::shard`]) build their estimator here, so they
+//! estimate the same thing, refuse the same input with the same message, and
+//! print the same [`Report`].
+use crate::error::Error;
+use crate::estimator::{Estimator, Quantity};
+use crate::method::{Method, Problem};
+use crate::report::{Header, Report, rod_exact, rod_quantities};
+use crate::rod::{Direction, Probe, Rod};
+use crate::runner::{RunConfig, RunResult, run};
+use crate::stats::Estimate;
+use crate::{flat, mesh};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Where a scene comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SceneSource {
+    /// A scene file, TOML or JSON by its extension; OBJ paths are relative
+    /// to its folder.
+    File(PathBuf),
+    /// The file's schema as JSON text (what a Python dict becomes); OBJ
+    /// paths are relative to the current directory.
+    Json(String),
+}
+
+impl SceneSource {
+    /// The scene's name in tables and messages: its file, or `<dict>`.
+    pub fn name(&self) -> String {
+        match self {
+            SceneSource::File(p) => p.display().to_string(),
+            SceneSource::Json(_) => "<dict>".to_owned(),
+        }
+    }
+
+    /// The file, if the scene is one.
+    fn path(&self) -> Option<&Path> {
+        match self {
+            SceneSource::File(p) => Some(p),
+            SceneSource::Json(_) => None,
+        }
+    }
+
+    /// The scene's dimension (2 or 3, by its sensor's point).
+    pub fn dimension(&self) -> Result<usize, Error> {
+        match self {
+            SceneSource::File(p) => flat::file::dimension(p),
+            SceneSource::Json(text) => {
+                let value: serde_json::Value = serde_json::from_str(text)
+                    .map_err(|e| Error::Scene(format!("the scene is not JSON: {e}")))?;
+                Ok(flat::file::dimension_of(&value))
+            }
+        }
+    }
+
+    /// Errors unless the scene is of dimension `want`, with a message that
+    /// names the command to use (the loader's own would name a field).
+    fn check_dimension(&self, want: usize) -> Result<(), Error> {
+        let got = self.dimension()?;
+        if got == want {
+            return Ok(());
+        }
+        let (is, use_) = if got == 2 {
+            ("a flatland (2D) scene", "flat")
+        } else {
+            ("a 3D scene", "mesh")
+        };
+        Err(Error::Scene(format!(
+            "{}: this is {is} (its sensor's point has {got} coordinates): use `geosens {use_}`",
+            self.name()
+        )))
+    }
+
+    /// The flatland scene.
+    pub fn flat(&self) -> Result<flat::Scene, Error> {
+        match self {
+            SceneSource::File(p) => flat::file::load(p),
+            SceneSource::Json(text) => flat::file::from_json(text),
+        }
+    }
+
+    /// The 3D scene.
+    pub fn mesh(&self) -> Result<mesh::Scene, Error> {
+        match self {
+            SceneSource::File(p) => mesh::file::load(p),
+            SceneSource::Json(text) => mesh::file::from_json(text),
+        }
+    }
+}
+
+/// What a job estimates on.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Target {
+    /// A probe on a rod: κs, κe, length, position and direction (±1).
+    Rod {
+        /// Scattering coefficient κs.
+        ks: f64,
+        /// Extinction coefficient κe.
+        ke: f64,
+        /// Length π̃.
+        length: f64,
+        /// Probe position.
+        x: f64,
+        /// Probe direction, ±1.
+        omega: f64,
+    },
+    /// A flatland scene (`geosens flat`).
+    Flat(SceneSource),
+    /// A 3D scene (`geosens mesh`).
+    Mesh(SceneSource),
+}
+
+/// One estimation: a target, a method and the finite differences' step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Job {
+    /// What to estimate on.
+    pub target: Target,
+    /// The method; `None` is the rod's exact solution (nothing sampled).
+    pub method: Option<Method>,
+    /// The half step of [`Method::Fd`] (its default if `None`); an error
+    /// with any other method.
+    pub fd_step: Option<f64>,
+}
+
+/// A job's estimator, built and checked, with what its printing and its
+/// shards need.
+pub struct Prepared {
+    /// The estimator; `None` for the rod's exact solution.
+    pub estimator: Option<Box<dyn Estimator>>,
+    /// What the table's first line says.
+    pub header: Header,
+    /// The estimator's caveats.
+    pub caveats: Vec<(Quantity, String)>,
+    /// The canonical text of what is estimated on (the rod's numbers, the
+    /// scene with its meshes inline), hashed into a shard's state.
+    canonical: Canonical,
+}
+
+/// What the hash of a job covers, kept unformatted until a shard needs it
+/// (a 3D scene's text takes a while to write).
+#[allow(missing_docs)]
+pub enum Canonical {
+    Rod([f64; 5]),
+    Flat(Arc<flat::Scene>),
+    Mesh(Arc<mesh::Scene>),
+}
+
+impl Prepared {
+    /// The text a shard's state hashes ([`Canonical::text`]).
+    pub fn canonical_text(&self, fd_step: Option<f64>) -> Result<String, Error> {
+        self.canonical.text(fd_step)
+    }
+}
+
+impl Canonical {
+    /// The text a shard's state hashes: the crate version, the runner's
+    /// chunking, the step of `fd`, and the rod or the scene in full.
+    pub fn text(&self, fd_step: Option<f64>) -> Result<String, Error> {
+        let what = match self {
+            Canonical::Rod(v) => format!("rod {:?}", v.map(f64::to_bits)),
+            Canonical::Flat(s) => serde_json::to_string(&flat::file::SceneFile::of(s))
+                .map_err(|e| Error::Output(e.to_string()))?,
+            Canonical::Mesh(s) => mesh::file::to_json(s)?,
+        };
+        Ok(format!(
+            "geosens {}\nchunk {} block {}\nfd_step {:?}\n{what}",
+            env!("CARGO_PKG_VERSION"),
+            crate::runner::CHUNK,
+            crate::runner::BLOCK,
+            fd_step.map(f64::to_bits),
+        ))
+    }
+}
+
+impl Job {
+    /// A job on a scene file: flatland or 3D by its sensor's point.
+    pub fn scene_file(path: impl Into<PathBuf>, method: Method, fd_step: Option<f64>) -> Job {
+        let source = SceneSource::File(path.into());
+        let target = match source.dimension() {
+            Ok(2) => Target::Flat(source),
+            _ => Target::Mesh(source),
+        };
+        Job {
+            target,
+            method: Some(method),
+            fd_step,
+        }
+    }
+
+    /// Builds the estimator, checking every input: the rod and probe, the
+    /// scene (and that its dimension matches the target), that `fd_step`
+    /// goes with `fd`, that the sensor is not a camera (its images come from
+    /// `geosens render`).
+    pub fn prepare(&self) -> Result<Prepared, Error> {
+        let method = self.method;
+        if self.fd_step.is_some() && method != Some(Method::Fd) {
+            let name = method.map_or("exact", Method::name);
+            return Err(Error::Config(format!(
+                "--fd-step sets the half step of --method fd, not of {name}"
+            )));
+        }
+        match &self.target {
+            &Target::Rod {
+                ks,
+                ke,
+                length,
+                x,
+                omega,
+            } => {
+                let rod = Rod::new(ks, ke, length)?;
+                let probe = Probe::new(&rod, x, Direction::from_sign(omega)?)?;
+                let estimator = match method {
+                    Some(m) => Some(estimator_of(m, (rod, probe), self.fd_step, None)?),
+                    None => None,
+                };
+                Ok(Prepared {
+                    caveats: estimator.as_ref().map_or(Vec::new(), |e| e.caveats()),
+                    estimator,
+                    header: Header::Rod {
+                        ks: rod.ks,
+                        ke: rod.ke,
+                        length: rod.length,
+                        x: probe.x,
+                        omega: probe.omega.sign(),
+                    },
+                    canonical: Canonical::Rod([
+                        rod.ks,
+                        rod.ke,
+                        rod.length,
+                        probe.x,
+                        probe.omega.sign(),
+                    ]),
+                })
+            }
+            Target::Flat(source) | Target::Mesh(source) => {
+                let flat = matches!(self.target, Target::Flat(_));
+                source.check_dimension(if flat { 2 } else { 3 })?;
+                let m = method.ok_or_else(|| {
+                    Error::Config("the exact solution is the rod's only (--method exact)".into())
+                })?;
+                let (estimator, shapes, parameters, canonical) = if flat {
+                    let scene = Arc::new(source.flat()?);
+                    let sizes = (scene.shapes().len(), scene.parameters().len());
+                    let est = estimator_of(m, Arc::clone(&scene), self.fd_step, source.path())?;
+                    (est, sizes.0, sizes.1, Canonical::Flat(scene))
+                } else {
+                    let scene = Arc::new(source.mesh()?);
+                    let sizes = (scene.shapes().len(), scene.parameters().len());
+                    let est = estimator_of(m, Arc::clone(&scene), self.fd_step, source.path())?;
+                    (est, sizes.0, sizes.1, Canonical::Mesh(scene))
+                };
+                if estimator.image().is_some() {
+                    return Err(Error::Config(format!(
+                        "{}: the sensor is a camera: its images come from `geosens render`",
+                        source.name()
+                    )));
+                }
+                Ok(Prepared {
+                    caveats: estimator.caveats(),
+                    estimator: Some(estimator),
+                    header: Header::Scene {
+                        scene: source.name(),
+                        shapes,
+                        parameters,
+                    },
+                    canonical,
+                })
+            }
+        }
+    }
+
+    /// Runs the job: what `geosens rod`, `flat` or `mesh` prints, as a
+    /// [`Report`].
+    pub fn run(&self, cfg: &RunConfig) -> Result<Report, Error> {
+        let prepared = self.prepare()?;
+        let result = match &prepared.estimator {
+            Some(est) => run(est.as_ref(), cfg)?,
+            None => exact_result(&prepared.header)?,
+        };
+        Ok(Report {
+            header: prepared.header,
+            result,
+            seed: cfg.seed,
+            caveats: prepared.caveats,
+        })
+    }
+}
+
+/// `method`'s estimator on `problem` with `fd_step`. An invalid displaced
+/// scene's error (`path`: its file, if any) gets a hint.
+fn estimator_of(
+    method: Method,
+    problem: impl Problem,
+    fd_step: Option<f64>,
+    path: Option<&Path>,
+) -> Result<Box<dyn Estimator>, Error> {
+    problem.estimator(method, fd_step).map_err(|e| match e {
+        Error::Scene(msg) => {
+            let file = path.map_or(String::new(), |p| format!("{}: ", p.display()));
+            let hint = if msg.contains("displaced by") {
+                "; try a smaller --fd-step"
+            } else {
+                ""
+            };
+            Error::Scene(format!("{file}{msg}{hint}"))
+        }
+        other => other,
+    })
+}
+
+/// The rod's exact solution as a [`RunResult`] (stderr 0, `paths` 0:
+/// nothing is sampled; `seconds` is the time of the evaluation).
+pub fn exact_result(header: &Header) -> Result<RunResult, Error> {
+    let &Header::Rod {
+        ks,
+        ke,
+        length,
+        x,
+        omega,
+    } = header
+    else {
+        return Err(Error::Config("the exact solution is the rod's only".into()));
+    };
+    let rod = Rod::new(ks, ke, length)?;
+    let probe = Probe::new(&rod, x, Direction::from_sign(omega)?)?;
+    let start = Instant::now();
+    let values = rod_exact(&rod, &probe);
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(RunResult {
+        method: "exact",
+        estimates: rod_quantities()
+            .into_iter()
+            .zip(values.map(Estimate::exact))
+            .collect(),
+        paths: 0,
+        seconds,
+    })
+}
+
+/// One rendering: what `geosens render` runs on a camera scene (3D, or
+/// flatland's line camera).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderJob {
+    /// The scene, whose sensor is a camera.
+    pub scene: SceneSource,
+    /// The method.
+    pub method: Method,
+    /// The half step of [`Method::Fd`] (its default if `None`).
+    pub fd_step: Option<f64>,
+}
+
+impl RenderJob {
+    /// Builds the estimator (flatland or 3D by the scene's dimension) and
+    /// checks that the sensor is a camera.
+    pub fn prepare(&self) -> Result<(Box<dyn Estimator>, Canonical), Error> {
+        if self.fd_step.is_some() && self.method != Method::Fd {
+            return Err(Error::Config(format!(
+                "--fd-step sets the half step of --method fd, not of {}",
+                self.method
+            )));
+        }
+        let path = self.scene.path();
+        let (est, canonical) = if self.scene.dimension()? == 2 {
+            let scene = Arc::new(self.scene.flat()?);
+            let est = estimator_of(self.method, Arc::clone(&scene), self.fd_step, path)?;
+            (est, Canonical::Flat(scene))
+        } else {
+            let scene = Arc::new(self.scene.mesh()?);
+            let est = estimator_of(self.method, Arc::clone(&scene), self.fd_step, path)?;
+            (est, Canonical::Mesh(scene))
+        };
+        if est.image().is_none() {
+            return Err(Error::Config(format!(
+                "{}: the scene's sensor is not a camera: an image needs `[sensor] kind = \"camera\"` \
+                 (`geosens flat` or `geosens mesh` estimate at a probe)",
+                self.scene.name()
+            )));
+        }
+        Ok((est, canonical))
+    }
+
+    /// Renders every pixel with `spp` paths from `seed` on `threads`
+    /// threads (0: all cores); `progress` is called with the rows done.
+    pub fn run(
+        &self,
+        spp: u64,
+        seed: u64,
+        threads: usize,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<ImageReport, Error> {
+        let (est, _) = self.prepare()?;
+        let result = crate::image::render(est.as_ref(), spp, seed, threads, progress)?;
+        Ok(ImageReport {
+            result,
+            caveats: est.caveats(),
+        })
+    }
+}
+
+/// A rendering's images with the estimator's caveats: what `geosens render`
+/// writes and prints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImageReport {
+    /// The images.
+    pub result: crate::image::ImageResult,
+    /// Why a quantity may be far off whatever its error bar.
+    pub caveats: Vec<(Quantity, String)>,
+}
+
+/// The JSON line of `geosens render`.
+#[derive(serde::Serialize)]
+struct RenderJsonLine<'a> {
+    method: &'a str,
+    #[serde(rename = "I")]
+    intensity: crate::report::MeanErr,
+    sensitivity: serde_json::Map<String, serde_json::Value>,
+    width: u32,
+    height: u32,
+    paths: u64,
+    seconds: f64,
+}
+
+impl ImageReport {
+    /// The warnings `geosens render` prints on stderr: one per caveat, one
+    /// per image with a pixel that is not finite.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w: Vec<String> = self
+            .caveats
+            .iter()
+            .map(|(q, why)| format!("warning: {q}: {why}"))
+            .collect();
+        for (q, img) in &self.result.images {
+            if img
+                .iter()
+                .any(|e| !e.mean.is_finite() || !e.stderr.is_finite())
+            {
+                w.push(format!(
+                    "warning: {q}: some pixels are not finite (overflow)"
+                ));
+            }
+        }
+        w
+    }
+
+    /// The JSON line (without its newline): every image's mean pixel value
+    /// with its standard error, the size, the paths and the time.
+    pub fn json(&self) -> Result<String, Error> {
+        let r = &self.result;
+        let mut intensity = None;
+        let mut sensitivity = serde_json::Map::new();
+        for ((q, _), e) in r.images.iter().zip(&r.means) {
+            let m = crate::report::MeanErr::of(e, crate::report::caveat_of(&self.caveats, q));
+            match q {
+                Quantity::Intensity => intensity = Some(m),
+                Quantity::Sensitivity(p) => {
+                    sensitivity.insert(
+                        p.clone(),
+                        serde_json::to_value(m).map_err(|e| Error::Output(e.to_string()))?,
+                    );
+                }
+                Quantity::Gradient(_) => {}
+            }
+        }
+        serde_json::to_string(&RenderJsonLine {
+            method: r.method,
+            intensity: intensity.ok_or_else(|| Error::Output("no intensity image".into()))?,
+            sensitivity,
+            width: r.width,
+            height: r.height,
+            paths: r.paths(),
+            seconds: r.seconds,
+        })
+        .map_err(|e| Error::Output(e.to_string()))
+    }
+}

@@ -1,0 +1,356 @@
+//! A run split over processes and machines: shard `I/N` samples only its
+//! share of the run's blocks ([`runner::BLOCK`] chunks each) and writes
+//! their exact moments to a [`State`]; [`merge`] checks that a set of states
+//! is one whole run and folds their blocks in order, which is the single
+//! run's own reduction (see [`crate::runner`]): the merged result is the
+//! single run's, bit for bit, whatever the number of shards, machines or
+//! threads. Book: chapter "Beyond one machine".
+//!
+//! A state is JSON: the run's identity (method, seed, total paths, number of
+//! shards, and a SHA-256 of the crate version, the chunking, the step of
+//! `fd` and the rod or the scene in full, meshes inline), this shard's index
+//! and blocks, what the printing needs ([`Header`], caveats), and per block
+//! and quantity the moments, every float as its IEEE-754 bits (JSON numbers
+//! would lose NaN and infinity, which an overflowed run must keep).
+use crate::error::Error;
+use crate::estimator::Quantity;
+use crate::job::Job;
+use crate::method::Method;
+use crate::report::{Header, Report};
+use crate::runner::{self, BLOCK, CHUNK, RunConfig, RunResult};
+use crate::stats::Moments;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::fmt;
+use std::ops::Range;
+use std::str::FromStr;
+
+/// The format tag of a state file; a reader refuses any other.
+pub const STATE_FORMAT: &str = "geosens-state/1";
+
+/// Most shards a run may be split into.
+pub const MAX_SHARDS: u64 = 1 << 20;
+
+/// Shard `index` of `count` (1 ≤ index ≤ count), written `I/N` as on the
+/// command line (`--shard 2/4`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// Which shard, from 1.
+    pub index: u64,
+    /// How many shards the run is split into.
+    pub count: u64,
+}
+
+impl Shard {
+    /// The whole run as one shard.
+    pub const WHOLE: Shard = Shard { index: 1, count: 1 };
+
+    /// Shard `index` of `count`; errors unless `1 ≤ index ≤ count ≤
+    /// MAX_SHARDS`.
+    pub fn new(index: u64, count: u64) -> Result<Shard, Error> {
+        if count == 0 || count > MAX_SHARDS || index == 0 || index > count {
+            return Err(Error::Config(format!(
+                "shard {index}/{count}: expected I/N with 1 ≤ I ≤ N ≤ {MAX_SHARDS}"
+            )));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The blocks of this shard among `total` blocks: the `index`-th of
+    /// `count` contiguous, nearly equal ranges (some empty if `count >
+    /// total`).
+    pub fn blocks(&self, total: u64) -> Range<u64> {
+        let at = |i: u64| (u128::from(total) * u128::from(i) / u128::from(self.count)) as u64;
+        at(self.index - 1)..at(self.index)
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl FromStr for Shard {
+    type Err = Error;
+
+    /// Parses `I/N`.
+    fn from_str(s: &str) -> Result<Shard, Error> {
+        let bad = || Error::Config(format!("shard {s:?}: expected I/N, e.g. 2/4 (1 ≤ I ≤ N)"));
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let i = i.trim().parse().map_err(|_| bad())?;
+        let n = n.trim().parse().map_err(|_| bad())?;
+        Shard::new(i, n)
+    }
+}
+
+/// One block's moments of one quantity, every float as its bits: count,
+/// non-zero count, mean, M2, M3, M4, largest |w|, Σ|w|.
+type Packed = [u64; 8];
+
+fn pack(m: &Moments) -> Packed {
+    [
+        m.n,
+        m.nonzero,
+        m.mean.to_bits(),
+        m.m2.to_bits(),
+        m.m3.to_bits(),
+        m.m4.to_bits(),
+        m.max_abs.to_bits(),
+        m.sum_abs.to_bits(),
+    ]
+}
+
+fn unpack(p: &Packed) -> Moments {
+    Moments {
+        n: p[0],
+        nonzero: p[1],
+        mean: f64::from_bits(p[2]),
+        m2: f64::from_bits(p[3]),
+        m3: f64::from_bits(p[4]),
+        m4: f64::from_bits(p[5]),
+        max_abs: f64::from_bits(p[6]),
+        sum_abs: f64::from_bits(p[7]),
+    }
+}
+
+/// What identifies a run: two states merge only if these are equal.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RunId {
+    /// Method name.
+    pub method: String,
+    /// SHA-256 (hex) of what the run estimates on
+    /// ([`Prepared::canonical_text`](crate::job::Prepared::canonical_text)).
+    pub hash: String,
+    /// Seed of the run.
+    pub seed: u64,
+    /// Paths of the whole run.
+    pub paths: u64,
+    /// Number of shards.
+    pub shards: u64,
+}
+
+/// The exact accumulator state of one shard of a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct State {
+    /// [`STATE_FORMAT`].
+    pub format: String,
+    /// The crate version that wrote it.
+    pub version: String,
+    /// The run it belongs to.
+    pub run: RunId,
+    /// Which shard this is (from 1).
+    pub shard: u64,
+    /// What the printing needs.
+    pub header: Header,
+    /// The estimator's caveats.
+    pub caveats: Vec<(Quantity, String)>,
+    /// The quantities, in the estimator's order.
+    pub quantities: Vec<Quantity>,
+    /// The first block of this shard.
+    pub first_block: u64,
+    /// Per block (from `first_block`), per quantity, the packed moments.
+    pub blocks: Vec<Vec<Packed>>,
+    /// Paths this shard sampled.
+    pub paths: u64,
+    /// Wall time of this shard's sampling, in seconds.
+    pub seconds: f64,
+}
+
+impl State {
+    /// The state as one line of JSON.
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string(self).map_err(|e| Error::Output(e.to_string()))
+    }
+
+    /// Reads a state from JSON; errors if it is not one or of another
+    /// format.
+    pub fn from_json(text: &str) -> Result<State, Error> {
+        let format = serde_json::from_str::<serde_json::Value>(text)
+            .ok()
+            .and_then(|v| v.get("format").and_then(|f| f.as_str().map(str::to_owned)));
+        match format.as_deref() {
+            Some(STATE_FORMAT) => {}
+            Some(other) => {
+                return Err(Error::Merge(format!(
+                    "a state of format {other:?}, expected {STATE_FORMAT:?}"
+                )));
+            }
+            None => return Err(Error::Merge("not a geosens state (no \"format\")".into())),
+        }
+        serde_json::from_str(text).map_err(|e| Error::Merge(format!("a malformed state: {e}")))
+    }
+
+    /// The shard this state holds.
+    pub fn shard(&self) -> Shard {
+        Shard {
+            index: self.shard,
+            count: self.run.shards,
+        }
+    }
+}
+
+/// Paths in blocks `blocks` of a run of `paths` paths.
+fn paths_in(blocks: &Range<u64>, paths: u64) -> u64 {
+    let per_block = BLOCK * CHUNK;
+    let at = |b: u64| paths.min(b.saturating_mul(per_block));
+    at(blocks.end) - at(blocks.start)
+}
+
+impl Job {
+    /// Runs shard `shard` of the job's run `cfg` and returns its state.
+    /// Errors as [`Job::run`] does, and for the rod's exact solution
+    /// (nothing to sample).
+    pub fn run_shard(&self, cfg: &RunConfig, shard: Shard) -> Result<State, Error> {
+        let prepared = self.prepare()?;
+        let est = prepared.estimator.as_ref().ok_or_else(|| {
+            Error::Config("the exact solution samples nothing: it has no shards".into())
+        })?;
+        let total = runner::blocks(cfg.paths);
+        let range = shard.blocks(total);
+        let (moments, seconds) = runner::sample_blocks(est.as_ref(), cfg, range.clone())?;
+        let hash = Sha256::digest(prepared.canonical_text(self.fd_step)?.as_bytes());
+        Ok(State {
+            format: STATE_FORMAT.to_owned(),
+            version: env!("CARGO_PKG_VERSION").to_owned(),
+            run: RunId {
+                method: est.method().to_owned(),
+                hash: hash.iter().map(|b| format!("{b:02x}")).collect(),
+                seed: cfg.seed,
+                paths: cfg.paths,
+                shards: shard.count,
+            },
+            shard: shard.index,
+            header: prepared.header,
+            caveats: prepared.caveats,
+            quantities: est.quantities(),
+            first_block: range.start,
+            blocks: moments
+                .iter()
+                .map(|b| b.iter().map(pack).collect())
+                .collect(),
+            paths: paths_in(&range, cfg.paths),
+            seconds,
+        })
+    }
+}
+
+/// Merges the states of every shard of one run (`labelled`: each with the
+/// name the messages give it, e.g. its file) into the single run's
+/// [`Report`], bit for bit; its `seconds` is the sum of the shards'.
+///
+/// Errors, naming the states at fault, unless they are of this format and
+/// version, of one run (same method, hash, seed, paths, number of shards,
+/// header, caveats and quantities), every shard present exactly once, each
+/// holding exactly its blocks.
+pub fn merge(labelled: &[(String, State)]) -> Result<Report, Error> {
+    let Some((first_label, first)) = labelled.first() else {
+        return Err(Error::Merge("nothing to merge: no state given".into()));
+    };
+    let this_version = env!("CARGO_PKG_VERSION");
+    let n = first.run.shards;
+    let mut by_index: Vec<Option<&(String, State)>> = vec![None; n as usize];
+    let total = runner::blocks(first.run.paths);
+    for pair in labelled {
+        let (label, s) = pair;
+        if s.version != this_version {
+            return Err(Error::Merge(format!(
+                "{label}: written by geosens {}, this is {this_version}",
+                s.version
+            )));
+        }
+        if s.run != first.run {
+            return Err(Error::Merge(format!(
+                "{label} and {first_label} are not of one run: {}",
+                differences(&s.run, &first.run)
+            )));
+        }
+        if s.header != first.header
+            || s.caveats != first.caveats
+            || s.quantities != first.quantities
+        {
+            return Err(Error::Merge(format!(
+                "{label} and {first_label} are not of one run: their scenes or probes differ"
+            )));
+        }
+        let shard = Shard::new(s.shard, n).map_err(|e| Error::Merge(format!("{label}: {e}")))?;
+        let slot = &mut by_index[(shard.index - 1) as usize];
+        if let Some((other, _)) = slot {
+            return Err(Error::Merge(format!(
+                "shard {shard} given twice: {other} and {label}"
+            )));
+        }
+        let want = shard.blocks(total);
+        let nq = s.quantities.len();
+        if s.first_block != want.start
+            || s.blocks.len() as u64 != want.end - want.start
+            || s.blocks.iter().any(|b| b.len() != nq)
+            || s.paths != paths_in(&want, s.run.paths)
+        {
+            return Err(Error::Merge(format!(
+                "{label}: shard {shard} should hold blocks {}..{} of the run: it is damaged",
+                want.start, want.end
+            )));
+        }
+        *slot = Some(pair);
+    }
+    let missing: Vec<String> = by_index
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.is_none())
+        .map(|(i, _)| format!("{}/{n}", i + 1))
+        .collect();
+    if !missing.is_empty() {
+        return Err(Error::Merge(format!(
+            "shard{} {} missing: a run of {n} shards merges only whole",
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", ")
+        )));
+    }
+    let states: Vec<&State> = by_index.iter().flatten().map(|(_, s)| s).collect();
+    let nq = first.quantities.len();
+    let blocks: Vec<Vec<Moments>> = states
+        .iter()
+        .flat_map(|s| &s.blocks)
+        .map(|b| b.iter().map(unpack).collect())
+        .collect();
+    let total = runner::fold_blocks(nq, blocks.iter().map(Vec::as_slice));
+    let method: Method = first.run.method.parse()?;
+    Ok(Report {
+        header: first.header.clone(),
+        result: RunResult {
+            method: method.name(),
+            estimates: first
+                .quantities
+                .iter()
+                .cloned()
+                .zip(total.iter().map(Moments::estimate))
+                .collect(),
+            paths: first.run.paths,
+            seconds: states.iter().map(|s| s.seconds).sum(),
+        },
+        seed: first.run.seed,
+        caveats: first.caveats.clone(),
+    })
+}
+
+/// Which fields of two run identities differ, for a message.
+fn differences(a: &RunId, b: &RunId) -> String {
+    let mut d = Vec::new();
+    if a.method != b.method {
+        d.push(format!("method {} against {}", a.method, b.method));
+    }
+    if a.hash != b.hash {
+        d.push("different scenes, probes or fd steps (their hashes differ)".to_owned());
+    }
+    if a.seed != b.seed {
+        d.push(format!("seed {} against {}", a.seed, b.seed));
+    }
+    if a.paths != b.paths {
+        d.push(format!("{} paths against {}", a.paths, b.paths));
+    }
+    if a.shards != b.shards {
+        d.push(format!("{} shards against {}", a.shards, b.shards));
+    }
+    d.join("; ")
+}
