@@ -60,18 +60,43 @@ impl ImageResult {
     }
 }
 
-/// Runs `est` (a camera's) with `spp` paths per pixel from `seed` on
-/// `threads` threads (0: all cores); `progress` is called with the number of
-/// rows done after each row. Errors if the estimator has no camera, `spp`
-/// is below 2 or above [`MAX_SPP`], or the pool cannot start.
-pub fn render(
-    est: &dyn Estimator,
-    spp: u64,
-    seed: u64,
-    threads: usize,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<ImageResult, Error> {
-    let Some((width, height)) = est.image() else {
+/// One pixel's result for one quantity: its estimate's mean and standard
+/// error (from its strata) and the moments of all its weights pooled (the
+/// reliability diagnostics). What a shard of a rendering keeps per pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PixelSums {
+    /// The pixel's mean (the mean of its strata's means).
+    pub mean: f64,
+    /// Its stratified standard error.
+    pub stderr: f64,
+    /// The moments of all its weights.
+    pub pooled: Moments,
+}
+
+impl PixelSums {
+    /// The pixel's sums of one quantity, its strata closed.
+    pub fn of(s: &StratumSums) -> PixelSums {
+        let e = s.estimate();
+        PixelSums {
+            mean: e.mean,
+            stderr: e.stderr,
+            pooled: s.pooled(),
+        }
+    }
+
+    /// The pixel's estimate (as [`StratumSums::estimate`]).
+    pub fn estimate(&self) -> Estimate {
+        Estimate {
+            mean: self.mean,
+            stderr: self.stderr,
+            ..self.pooled.estimate()
+        }
+    }
+}
+
+/// Checks that `est` has a camera and `spp` is in range; its image size.
+fn image_size(est: &dyn Estimator, spp: u64) -> Result<(u32, u32), Error> {
+    let Some(size) = est.image() else {
         return Err(Error::Config(
             "the scene's sensor is not a camera: an image needs `[sensor] kind = \"camera\"`"
                 .into(),
@@ -82,40 +107,70 @@ pub fn render(
             "spp = {spp}: expected 2 to 2^32 paths per pixel (an error bar needs two)"
         )));
     }
+    Ok(size)
+}
+
+/// Renders rows `rows` of `est`'s camera, `spp` paths per pixel from
+/// `seed` on `threads` threads (0: all cores); `progress` is called with
+/// the number of rows done after each row. Returns, per pixel of those rows
+/// (row-major) and per quantity, its [`PixelSums`], and the wall time. A
+/// pixel's samples depend on its index only, so any split of the rows gives
+/// the same pixels. Errors as [`render`].
+pub fn render_rows(
+    est: &dyn Estimator,
+    spp: u64,
+    seed: u64,
+    threads: usize,
+    rows: std::ops::Range<u32>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<(Vec<Vec<PixelSums>>, f64), Error> {
+    let (width, _) = image_size(est, spp)?;
     crate::runner::check_threads(threads)?;
-    let quantities = est.quantities();
-    let nq = quantities.len();
+    let nq = est.quantities().len();
     let done = std::sync::atomic::AtomicU64::new(0);
-    let row = |r: u32| -> Vec<Vec<StratumSums>> {
+    let row = |r: u32| -> Vec<Vec<PixelSums>> {
         let out = (0..width)
             .map(|c| {
                 let p = r * width + c;
                 let mut rng = rng::stream(seed, p as u64);
                 let mut sums = vec![StratumSums::default(); nq];
                 est.accumulate_pixel(&mut rng, p, spp, &mut sums);
-                sums
+                sums.iter().map(PixelSums::of).collect()
             })
             .collect();
         progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
         out
     };
-    let (rows, seconds) = crate::runner::timed_on(threads, || -> Vec<Vec<Vec<StratumSums>>> {
+    let (rows, seconds) = crate::runner::timed_on(threads, || -> Vec<Vec<Vec<PixelSums>>> {
         if threads == 1 {
-            (0..height).map(row).collect()
+            rows.map(row).collect()
         } else {
-            (0..height).into_par_iter().map(row).collect()
+            rows.into_par_iter().map(row).collect()
         }
     })?;
-    let pixels = (width as usize) * (height as usize);
+    Ok((rows.into_iter().flatten().collect(), seconds))
+}
+
+/// The images of every pixel's sums (`pixels`: row-major, all of them),
+/// with the image means: what [`render`] returns.
+pub fn assemble(
+    method: &'static str,
+    quantities: Vec<Quantity>,
+    (width, height): (u32, u32),
+    spp: u64,
+    pixels: &[Vec<PixelSums>],
+    seconds: f64,
+) -> ImageResult {
+    let nq = quantities.len();
     let mut images: Vec<(Quantity, Vec<Estimate>)> = quantities
         .into_iter()
-        .map(|q| (q, Vec::with_capacity(pixels)))
+        .map(|q| (q, Vec::with_capacity(pixels.len())))
         .collect();
     let mut pooled = vec![Moments::default(); nq];
-    for pixel in rows.iter().flatten() {
+    for pixel in pixels {
         for ((_, img), (m, all)) in images.iter_mut().zip(pixel.iter().zip(&mut pooled)) {
             img.push(m.estimate());
-            *all = all.merge(&m.pooled());
+            *all = all.merge(&m.pooled);
         }
     }
     let means = images
@@ -129,13 +184,37 @@ pub fn render(
             e
         })
         .collect();
-    Ok(ImageResult {
-        method: est.method(),
+    ImageResult {
+        method,
         width,
         height,
         images,
         means,
         spp,
         seconds,
-    })
+    }
+}
+
+/// Runs `est` (a camera's) with `spp` paths per pixel from `seed` on
+/// `threads` threads (0: all cores); `progress` is called with the number of
+/// rows done after each row. Errors if the estimator has no camera, `spp`
+/// is below 2 or above [`MAX_SPP`], `threads` above
+/// [`MAX_THREADS`](crate::runner::MAX_THREADS), or the pool cannot start.
+pub fn render(
+    est: &dyn Estimator,
+    spp: u64,
+    seed: u64,
+    threads: usize,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<ImageResult, Error> {
+    let size = image_size(est, spp)?;
+    let (pixels, seconds) = render_rows(est, spp, seed, threads, 0..size.1, progress)?;
+    Ok(assemble(
+        est.method(),
+        est.quantities(),
+        size,
+        spp,
+        &pixels,
+        seconds,
+    ))
 }

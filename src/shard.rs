@@ -14,7 +14,8 @@
 //! would lose NaN and infinity, which an overflowed run must keep).
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::job::Job;
+use crate::image::{PixelSums, assemble, render_rows};
+use crate::job::{ImageReport, Job, RenderJob};
 use crate::method::Method;
 use crate::report::{Header, Report};
 use crate::runner::{self, BLOCK, CHUNK, RunConfig, RunResult};
@@ -114,6 +115,62 @@ fn unpack(p: &Packed) -> Moments {
     }
 }
 
+/// A shard's accumulators.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Payload {
+    /// A probe's run: its blocks' moments.
+    Blocks {
+        /// The shard's first block.
+        first: u64,
+        /// Per block (from `first`), per quantity, the packed moments.
+        moments: Vec<Vec<Packed>>,
+    },
+    /// A rendering: its rows' pixels.
+    Rows {
+        /// The shard's first row.
+        first: u32,
+        /// Pixels per row.
+        width: u32,
+        /// Rows of the whole image.
+        height: u32,
+        /// Per pixel of the shard's rows (row-major), per quantity: the
+        /// packed pooled moments, then the bits of the pixel's mean and
+        /// standard error.
+        pixels: Vec<Vec<PackedPixel>>,
+    },
+}
+
+/// One pixel's [`PixelSums`] of one quantity: the packed pooled moments,
+/// the bits of its mean and standard error.
+type PackedPixel = [u64; 10];
+
+fn pack_pixel(p: &PixelSums) -> PackedPixel {
+    let m = pack(&p.pooled);
+    [
+        m[0],
+        m[1],
+        m[2],
+        m[3],
+        m[4],
+        m[5],
+        m[6],
+        m[7],
+        p.mean.to_bits(),
+        p.stderr.to_bits(),
+    ]
+}
+
+fn unpack_pixel(p: &PackedPixel) -> PixelSums {
+    let mut m = [0; 8];
+    m.copy_from_slice(&p[..8]);
+    PixelSums {
+        pooled: unpack(&m),
+        mean: f64::from_bits(p[8]),
+        stderr: f64::from_bits(p[9]),
+    }
+}
+
 /// What identifies a run: two states merge only if these are equal.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct RunId {
@@ -124,7 +181,7 @@ pub struct RunId {
     pub hash: String,
     /// Seed of the run.
     pub seed: u64,
-    /// Paths of the whole run.
+    /// Paths of the whole run (per pixel, for a rendering).
     pub paths: u64,
     /// Number of shards.
     pub shards: u64,
@@ -147,10 +204,8 @@ pub struct State {
     pub caveats: Vec<(Quantity, String)>,
     /// The quantities, in the estimator's order.
     pub quantities: Vec<Quantity>,
-    /// The first block of this shard.
-    pub first_block: u64,
-    /// Per block (from `first_block`), per quantity, the packed moments.
-    pub blocks: Vec<Vec<Packed>>,
+    /// The shard's accumulators.
+    pub payload: Payload,
     /// Paths this shard sampled.
     pub paths: u64,
     /// Wall time of this shard's sampling, in seconds.
@@ -209,13 +264,12 @@ impl Job {
         let total = runner::blocks(cfg.paths);
         let range = shard.blocks(total);
         let (moments, seconds) = runner::sample_blocks(est.as_ref(), cfg, range.clone())?;
-        let hash = Sha256::digest(prepared.canonical_text(self.fd_step)?.as_bytes());
         Ok(State {
             format: STATE_FORMAT.to_owned(),
             version: env!("CARGO_PKG_VERSION").to_owned(),
             run: RunId {
                 method: est.method().to_owned(),
-                hash: hash.iter().map(|b| format!("{b:02x}")).collect(),
+                hash: sha256(&prepared.canonical_text(self.fd_step)?),
                 seed: cfg.seed,
                 paths: cfg.paths,
                 shards: shard.count,
@@ -224,33 +278,105 @@ impl Job {
             header: prepared.header,
             caveats: prepared.caveats,
             quantities: est.quantities(),
-            first_block: range.start,
-            blocks: moments
-                .iter()
-                .map(|b| b.iter().map(pack).collect())
-                .collect(),
+            payload: Payload::Blocks {
+                first: range.start,
+                moments: moments
+                    .iter()
+                    .map(|b| b.iter().map(pack).collect())
+                    .collect(),
+            },
             paths: paths_in(&range, cfg.paths),
             seconds,
         })
     }
 }
 
+impl RenderJob {
+    /// Renders shard `shard` of the image (its share of the rows) with
+    /// `spp` paths per pixel from `seed` on `threads` threads, and returns
+    /// its state; `progress` is called with the shard's rows done.
+    pub fn run_shard(
+        &self,
+        spp: u64,
+        seed: u64,
+        threads: usize,
+        shard: Shard,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<State, Error> {
+        let (est, canonical) = self.prepare()?;
+        let Some((width, height)) = est.image() else {
+            unreachable!("prepare checks the camera")
+        };
+        let range = shard.blocks(u64::from(height));
+        let rows = range.start as u32..range.end as u32;
+        let (pixels, seconds) =
+            render_rows(est.as_ref(), spp, seed, threads, rows.clone(), progress)?;
+        Ok(State {
+            format: STATE_FORMAT.to_owned(),
+            version: env!("CARGO_PKG_VERSION").to_owned(),
+            run: RunId {
+                method: est.method().to_owned(),
+                hash: sha256(&canonical.text(self.fd_step)?),
+                seed,
+                paths: spp,
+                shards: shard.count,
+            },
+            shard: shard.index,
+            header: Header::Scene {
+                scene: self.scene.name(),
+                shapes: 0,
+                parameters: 0,
+            },
+            caveats: est.caveats(),
+            quantities: est.quantities(),
+            payload: Payload::Rows {
+                first: rows.start,
+                width,
+                height,
+                pixels: pixels
+                    .iter()
+                    .map(|p| p.iter().map(pack_pixel).collect())
+                    .collect(),
+            },
+            paths: spp * u64::from(width) * u64::from(rows.end - rows.start),
+            seconds,
+        })
+    }
+}
+
+/// The SHA-256 of `text`, in hex.
+fn sha256(text: &str) -> String {
+    Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// A merged run: a probe's report or a rendering's images.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Merged {
+    /// What `geosens rod`, `flat` or `mesh` prints.
+    Probe(Report),
+    /// What `geosens render` writes and prints.
+    Image(ImageReport),
+}
+
 /// Merges the states of every shard of one run (`labelled`: each with the
-/// name the messages give it, e.g. its file) into the single run's
-/// [`Report`], bit for bit; its `seconds` is the sum of the shards'.
+/// name the messages give it, e.g. its file) into the single run's result,
+/// bit for bit: a probe's [`Report`] or a rendering's images. Its `seconds`
+/// is the sum of the shards'.
 ///
 /// Errors, naming the states at fault, unless they are of this format and
 /// version, of one run (same method, hash, seed, paths, number of shards,
 /// header, caveats and quantities), every shard present exactly once, each
-/// holding exactly its blocks.
-pub fn merge(labelled: &[(String, State)]) -> Result<Report, Error> {
+/// holding exactly its blocks or rows.
+pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
     let Some((first_label, first)) = labelled.first() else {
         return Err(Error::Merge("nothing to merge: no state given".into()));
     };
     let this_version = env!("CARGO_PKG_VERSION");
     let n = first.run.shards;
     let mut by_index: Vec<Option<&(String, State)>> = vec![None; n as usize];
-    let total = runner::blocks(first.run.paths);
     for pair in labelled {
         let (label, s) = pair;
         if s.version != this_version {
@@ -268,6 +394,7 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Report, Error> {
         if s.header != first.header
             || s.caveats != first.caveats
             || s.quantities != first.quantities
+            || std::mem::discriminant(&s.payload) != std::mem::discriminant(&first.payload)
         {
             return Err(Error::Merge(format!(
                 "{label} and {first_label} are not of one run: their scenes or probes differ"
@@ -280,16 +407,9 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Report, Error> {
                 "shard {shard} given twice: {other} and {label}"
             )));
         }
-        let want = shard.blocks(total);
-        let nq = s.quantities.len();
-        if s.first_block != want.start
-            || s.blocks.len() as u64 != want.end - want.start
-            || s.blocks.iter().any(|b| b.len() != nq)
-            || s.paths != paths_in(&want, s.run.paths)
-        {
+        if let Some(range) = misplaced(s, first) {
             return Err(Error::Merge(format!(
-                "{label}: shard {shard} should hold blocks {}..{} of the run: it is damaged",
-                want.start, want.end
+                "{label}: shard {shard} should hold {range} of the run: it is damaged"
             )));
         }
         *slot = Some(pair);
@@ -309,29 +429,102 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Report, Error> {
     }
     let states: Vec<&State> = by_index.iter().flatten().map(|(_, s)| s).collect();
     let nq = first.quantities.len();
-    let blocks: Vec<Vec<Moments>> = states
-        .iter()
-        .flat_map(|s| &s.blocks)
-        .map(|b| b.iter().map(unpack).collect())
-        .collect();
-    let total = runner::fold_blocks(nq, blocks.iter().map(Vec::as_slice));
-    let method: Method = first.run.method.parse()?;
-    Ok(Report {
-        header: first.header.clone(),
-        result: RunResult {
-            method: method.name(),
-            estimates: first
-                .quantities
+    let method = first.run.method.parse::<Method>()?.name();
+    let seconds = states.iter().map(|s| s.seconds).sum();
+    let estimates = |total: Vec<Moments>| -> Vec<(Quantity, crate::stats::Estimate)> {
+        first
+            .quantities
+            .iter()
+            .cloned()
+            .zip(total.iter().map(Moments::estimate))
+            .collect()
+    };
+    Ok(match &first.payload {
+        Payload::Blocks { .. } => {
+            let blocks: Vec<Vec<Moments>> = states
                 .iter()
-                .cloned()
-                .zip(total.iter().map(Moments::estimate))
-                .collect(),
-            paths: first.run.paths,
-            seconds: states.iter().map(|s| s.seconds).sum(),
-        },
-        seed: first.run.seed,
-        caveats: first.caveats.clone(),
+                .flat_map(|s| match &s.payload {
+                    Payload::Blocks { moments, .. } => moments.as_slice(),
+                    Payload::Rows { .. } => &[],
+                })
+                .map(|b| b.iter().map(unpack).collect())
+                .collect();
+            let total = runner::fold_blocks(nq, blocks.iter().map(Vec::as_slice));
+            Merged::Probe(Report {
+                header: first.header.clone(),
+                result: RunResult {
+                    method,
+                    estimates: estimates(total),
+                    paths: first.run.paths,
+                    seconds,
+                },
+                seed: first.run.seed,
+                caveats: first.caveats.clone(),
+            })
+        }
+        &Payload::Rows { width, height, .. } => {
+            let pixels: Vec<Vec<PixelSums>> = states
+                .iter()
+                .flat_map(|s| match &s.payload {
+                    Payload::Rows { pixels, .. } => pixels.as_slice(),
+                    Payload::Blocks { .. } => &[],
+                })
+                .map(|p| p.iter().map(unpack_pixel).collect())
+                .collect();
+            Merged::Image(ImageReport {
+                result: assemble(
+                    method,
+                    first.quantities.clone(),
+                    (width, height),
+                    first.run.paths,
+                    &pixels,
+                    seconds,
+                ),
+                caveats: first.caveats.clone(),
+            })
+        }
     })
+}
+
+/// `None` if state `s` holds exactly its shard's blocks or rows (with one
+/// accumulator per quantity, the paths they count, and the image size of
+/// `first`); else what it should hold, for the message.
+fn misplaced(s: &State, first: &State) -> Option<String> {
+    let nq = s.quantities.len();
+    let shard = s.shard();
+    match (&s.payload, &first.payload) {
+        (Payload::Blocks { first: at, moments }, _) => {
+            let want = shard.blocks(runner::blocks(s.run.paths));
+            let ok = *at == want.start
+                && moments.len() as u64 == want.end - want.start
+                && moments.iter().all(|b| b.len() == nq)
+                && s.paths == paths_in(&want, s.run.paths);
+            (!ok).then(|| format!("blocks {}..{}", want.start, want.end))
+        }
+        (
+            Payload::Rows {
+                first: at,
+                width,
+                height,
+                pixels,
+            },
+            Payload::Rows {
+                width: w0,
+                height: h0,
+                ..
+            },
+        ) => {
+            let want = shard.blocks(u64::from(*height));
+            let rows = want.end - want.start;
+            let ok = (width, height) == (w0, h0)
+                && u64::from(*at) == want.start
+                && pixels.len() as u64 == rows * u64::from(*width)
+                && pixels.iter().all(|p| p.len() == nq)
+                && s.paths == s.run.paths * rows * u64::from(*width);
+            (!ok).then(|| format!("rows {}..{} of a {w0}×{h0} image", want.start, want.end))
+        }
+        (Payload::Rows { .. }, Payload::Blocks { .. }) => Some("blocks, not rows".into()),
+    }
 }
 
 /// Which fields of two run identities differ, for a message.

@@ -2,6 +2,7 @@
 //! one JSON line.
 use super::*;
 use geosens::report::{yes_no, z_text};
+use geosens::shard::Merged;
 
 /// `geosens rod`.
 pub(super) fn rod_command(
@@ -62,7 +63,7 @@ fn estimate(
 
 /// Writes `state` to `path` (through a temporary file beside it, so that a
 /// killed shard leaves no half-written state).
-fn write_state(path: &std::path::Path, state: &State) -> Result<(), Error> {
+pub(super) fn write_state(path: &std::path::Path, state: &State) -> Result<(), Error> {
     let cannot = |e: std::io::Error| Error::Output(format!("cannot write {}: {e}", path.display()));
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(".part");
@@ -108,7 +109,25 @@ pub(super) fn merge_command(
             })?;
         states.push((name, state));
     }
-    print_report(&geosens::shard::merge(&states)?, args.json, out)
+    match geosens::shard::merge(&states)? {
+        Merged::Probe(report) => {
+            if args.out.is_some() {
+                return Err(Error::Config(
+                    "--out is for a rendering's states; these are a probe's".into(),
+                )
+                .into());
+            }
+            print_report(&report, args.json, out)
+        }
+        Merged::Image(report) => {
+            let dir = args.out.as_deref().ok_or_else(|| {
+                Error::Config(
+                    "these are a rendering's states: --out DIR says where its images go".into(),
+                )
+            })?;
+            super::render::finish(&report, dir, out)
+        }
+    }
 }
 
 /// The paper's rods: name, κs, κe (length 2).

@@ -86,9 +86,13 @@ struct MergeArgs {
     /// The state files, one per shard, in any order.
     #[arg(required = true, value_name = "FILE")]
     states: Vec<std::path::PathBuf>,
-    /// Print one JSON line instead of a table.
+    /// Print one JSON line instead of a table (a rendering's merge prints
+    /// its JSON line whatever).
     #[arg(long)]
     json: bool,
+    /// Folder a rendering's images go to (its states only).
+    #[arg(long)]
+    out: Option<std::path::PathBuf>,
 }
 
 /// `geosens flat` and `geosens mesh`: a scene file, a method, a run.

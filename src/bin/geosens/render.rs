@@ -26,9 +26,9 @@ pub(super) struct RenderArgs {
     /// Paths per pixel, at least 2.
     #[arg(long, default_value_t = 64, allow_hyphen_values = true)]
     spp: u64,
-    /// Folder the images go to (created if missing).
-    #[arg(long)]
-    out: PathBuf,
+    /// Folder the images go to (created if missing); not with `--state`.
+    #[arg(long, required_unless_present = "state")]
+    out: Option<PathBuf>,
     /// The finite differences' half step.
     #[command(flatten)]
     fd: FdArgs,
@@ -38,6 +38,9 @@ pub(super) struct RenderArgs {
     /// Worker threads, 0 = all cores (images do not depend on it).
     #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     threads: usize,
+    /// Sharding (by rows of the image).
+    #[command(flatten)]
+    shard: ShardArgs,
 }
 
 /// A parameter name as a file name: letters, digits, `-` and `_` kept,
@@ -121,6 +124,31 @@ pub(super) fn render_command(
         method: args.method,
         fd_step: args.fd.fd_step,
     };
+    if let Some(path) = &args.shard.state {
+        if args.out.is_some() {
+            return Err(Error::Config(
+                "--state writes the shard's state, not images: `geosens merge --out DIR` writes them"
+                    .into(),
+            )
+            .into());
+        }
+        let which = args.shard.shard.unwrap_or(Shard::WHOLE);
+        let state = job.run_shard(args.spp, args.seed, args.threads, which, &|_| {})?;
+        super::commands::write_state(path, &state)?;
+        eprintln!(
+            "wrote shard {which} ({} paths) to {}",
+            state.paths,
+            path.display()
+        );
+        return Ok(());
+    }
+    if let Some(s) = args.shard.shard {
+        return Err(Error::Config(format!(
+            "--shard {s} needs --state FILE, where the shard's state goes"
+        ))
+        .into());
+    }
+    let dir = args.out.as_deref().ok_or("--out DIR is needed")?;
     let (estimator, _) = job.prepare()?;
     let rows = estimator.image().map_or(0, |(_, h)| h);
     let bar = indicatif::ProgressBar::new(u64::from(rows));
@@ -142,16 +170,27 @@ pub(super) fn render_command(
         result: result?,
         caveats: estimator.caveats(),
     };
+    finish(&report, dir, out)
+}
+
+/// Writes the images of `report` into `dir` and prints its warnings, what
+/// was written (stderr) and its JSON line (`out`): the end of `geosens
+/// render`, and of `geosens merge` on a rendering's states.
+pub(super) fn finish(
+    report: &ImageReport,
+    dir: &Path,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
     let text = report.json()? + "\n";
     for w in report.warnings() {
         eprintln!("{w}");
     }
     let result = &report.result;
-    let written = write_images(result, &args.out)?;
+    let written = write_images(result, dir)?;
     eprintln!(
         "wrote {} files to {} ({}×{} pixels, {} paths per pixel, {:.2} s)",
         written.len(),
-        args.out.display(),
+        dir.display(),
         result.width,
         result.height,
         result.spp,
