@@ -391,7 +391,7 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
                 differences(&s.run, &first.run)
             )));
         }
-        if s.header != first.header
+        if !same_header(&s.header, &first.header)
             || s.caveats != first.caveats
             || s.quantities != first.quantities
             || std::mem::discriminant(&s.payload) != std::mem::discriminant(&first.payload)
@@ -484,6 +484,25 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
             })
         }
     })
+}
+
+/// Whether two shards' headers are of one run: equal but for the scene's
+/// name (a shard may name the same file by another path; the hash compares
+/// the contents, and the merge prints the first state's name).
+fn same_header(a: &Header, b: &Header) -> bool {
+    match (a, b) {
+        (
+            Header::Scene {
+                shapes, parameters, ..
+            },
+            Header::Scene {
+                shapes: s2,
+                parameters: p2,
+                ..
+            },
+        ) => (shapes, parameters) == (s2, p2),
+        _ => a == b,
+    }
 }
 
 /// `None` if state `s` holds exactly its shard's blocks or rows (with one

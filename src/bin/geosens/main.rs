@@ -12,6 +12,10 @@
 //! - `geosens render --scene FILE --method M --spp N --out DIR`: every pixel
 //!   of a 3D scene's camera, images of `I` and every `∂I/∂π` with their
 //!   error images, and one JSON line of the images' means;
+//! - every estimation command above takes `--shard I/N --state FILE` (run
+//!   only shard `I` of `N` and write its exact accumulator state), and
+//!   `geosens merge FILE… [--json] [--out DIR]` prints (or writes) what the
+//!   single run would have, bit for bit;
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
 //!   and thick rods at a few probes and prints them beside the exact solution,
 //!   then every method on two 3D occluder scenes beside their closed forms,
