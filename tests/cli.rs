@@ -337,14 +337,17 @@ fn compare_writes_the_figures() {
         String::from_utf8_lossy(&out.stderr)
     );
     // Figures drawn in several pictures keep their numbers in one JSON.
-    for (name, pictures) in [(
-        "stability",
-        &[
-            "stability_expectation",
-            "stability_rendering",
-            "stability_transport",
-        ][..],
-    )] {
+    for (name, pictures) in [
+        (
+            "stability",
+            &[
+                "stability_expectation",
+                "stability_rendering",
+                "stability_transport",
+            ][..],
+        ),
+        ("flat_scene", &["flat_scene_opaque", "flat_scene_media"][..]),
+    ] {
         for picture in pictures {
             for ext in ["png", "svg"] {
                 let path = dir.join(format!("{picture}.{ext}"));
@@ -361,7 +364,6 @@ fn compare_writes_the_figures() {
         "convergence",
         "efficiency",
         "finite_difference",
-        "flat_scene",
         "flat_warp",
         "flat_against_pi",
         "flat_convergence",
