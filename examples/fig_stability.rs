@@ -6,8 +6,10 @@
 //! ```text
 //! cargo run --release --example fig_stability -- [OUT_DIR] [EFFORT]
 //! ```
-//! writes `stability.{png,svg}` and `stability.json` (every cell's numbers)
-//! to `OUT_DIR` (default `out/figures`); `EFFORT` scales the path counts.
+//! writes `stability_expectation.{png,svg}`, `stability_rendering.{png,svg}`
+//! and `stability_transport.{png,svg}` (one figure per method) and
+//! `stability.json` (every cell's numbers) to `OUT_DIR` (default
+//! `out/figures`); `EFFORT` scales the path counts.
 use geosens::rod::figures::{FigureOptions, stability};
 
 fn main() -> Result<(), geosens::Error> {

@@ -336,14 +336,34 @@ fn compare_writes_the_figures() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // Figures drawn in several pictures keep their numbers in one JSON.
+    for (name, pictures) in [
+        (
+            "stability",
+            &[
+                "stability_expectation",
+                "stability_rendering",
+                "stability_transport",
+            ][..],
+        ),
+        ("flat_scene", &["flat_scene_opaque", "flat_scene_media"][..]),
+    ] {
+        for picture in pictures {
+            for ext in ["png", "svg"] {
+                let path = dir.join(format!("{picture}.{ext}"));
+                let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+                assert!(size >= 1000, "{} missing or empty", path.display());
+            }
+        }
+        let path = dir.join(format!("{name}.json"));
+        assert!(path.exists(), "{} missing", path.display());
+    }
     for name in [
         "intensity_along_rod",
         "sensitivity_along_rod",
         "convergence",
         "efficiency",
-        "stability",
         "finite_difference",
-        "flat_scene",
         "flat_warp",
         "flat_against_pi",
         "flat_convergence",

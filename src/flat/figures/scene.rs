@@ -12,11 +12,11 @@
 //! along one direction and has no corners of its own; the line camera
 //! (camera_line.toml) is drawn with its paths fanned across its field of
 //! view, without corner rings.
-//! One panel per shipped scene ([`SCENES`]) and one for the legend.
+//! One panel per shipped scene ([`SCENES`]), in two figures ([`FIGURES`]).
 //!
 //! The drawing helpers ([`shapes`], [`sensor`], [`ViewBox`]) serve the warp
 //! figure too.
-use super::{FigureOptions, load, save};
+use super::{FigureOptions, load};
 use crate::error::Error;
 use crate::flat::geometry::{NO_SEGMENT, perp};
 use crate::flat::lobe::cosine_direction;
@@ -41,6 +41,42 @@ pub const SCENES: [&str; 9] = [
     "submerged",
     "camera_line",
 ];
+
+/// The two figures: their file names and the scenes each draws (every
+/// scene of [`SCENES`] once): the scenes of opaque shapes only, then those
+/// with a medium.
+pub const FIGURES: [(&str, &[&str]); 2] = [
+    (
+        "flat_scene_opaque",
+        &["occluder", "polygon_occluder", "reflector", "camera_line"],
+    ),
+    (
+        "flat_scene_media",
+        &[
+            "absorbing_slab",
+            "fog",
+            "radiance",
+            "submerged",
+            "three_shapes",
+        ],
+    ),
+];
+
+/// What a scene shows, for its panel's title.
+fn what(name: &str) -> &'static str {
+    match name {
+        "occluder" => "a segment shadows the lamp",
+        "polygon_occluder" => "a non-convex Γ",
+        "reflector" => "light after a bounce",
+        "camera_line" => "a line camera",
+        "absorbing_slab" => "absorption only",
+        "fog" => "a scattering polygon",
+        "radiance" => "one line of sight",
+        "submerged" => "shapes in a fog",
+        "three_shapes" => "all three kinds",
+        _ => "",
+    }
+}
 
 /// Paths drawn per scene.
 pub const PATHS: usize = 20;
@@ -432,7 +468,8 @@ fn panel(name: &str, scene: &Scene, seed: u64) -> (Panel, SceneRecord) {
         ));
     }
     let title = format!(
-        "{name}.toml: {} parameter{}",
+        "{name}: {} ({} parameter{})",
+        what(name),
         scene.parameters().len(),
         if scene.parameters().len() == 1 {
             ""
@@ -459,27 +496,54 @@ fn panel(name: &str, scene: &Scene, seed: u64) -> (Panel, SceneRecord) {
 }
 
 /// The scenes drawn with their paths and boundary points, one panel per
-/// scene of [`SCENES`] (4 per row, the legend last). Writes `flat_scene.{png,svg}` and
-/// `flat_scene.json` (the paths, the hits and the corners). Samples only
-/// 20 paths per scene: the effort does not change it.
+/// scene, in two figures ([`FIGURES`]: opaque shapes only, 2 by 2 under a
+/// shared legend; scenes with a medium, 2 per row, the legend last).
+/// Writes `flat_scene_opaque.{png,svg}`, `flat_scene_media.{png,svg}` and
+/// `flat_scene.json` (the paths, the hits and the corners of every scene of
+/// [`SCENES`]). Samples only 20 paths per scene: the effort does not change
+/// it.
 pub fn scene(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let mut panels = Vec::new();
-    let mut records = Vec::new();
+    let mut drawn = Vec::new();
     for (i, name) in SCENES.iter().enumerate() {
         let scene = load(name)?;
         let (p, r) = panel(name, &scene, opts.seed.wrapping_add(SALT + i as u64));
-        panels.push(p);
-        records.push(r);
+        drawn.push((scene, p, r));
     }
-    panels.push(legend());
-    let mut figure = Figure::new(panels, 4);
-    figure.panel_size = (500, 500);
-    save(opts, "scene", &figure, &records)
+    let mut written = Vec::new();
+    for (file, names) in FIGURES {
+        let of = |name: &&str| SCENES.iter().position(|s| s == name).map(|i| &drawn[i]);
+        let group: Vec<_> = names.iter().filter_map(of).collect();
+        let surfaces = group
+            .iter()
+            .flat_map(|(scene, _, _)| scene.shapes().iter().map(|s| s.surface));
+        let legend = legend(surfaces);
+        let mut panels: Vec<Panel> = group.iter().map(|(_, p, _)| p.clone()).collect();
+        let mut figure = if panels.len() % 2 == 1 {
+            // An odd count leaves a slot for the legend.
+            panels.push(Panel {
+                title: format!("{PATHS} backward paths per scene"),
+                series: legend,
+                legend_only: true,
+                ..Panel::default()
+            });
+            Figure::new(panels, 2)
+        } else {
+            let mut figure = Figure::new(panels, 2);
+            figure.legend = legend;
+            figure
+        };
+        figure.panel_size = (500, 500);
+        written.extend(figure.save(&opts.out, file)?);
+    }
+    let records: Vec<SceneRecord> = drawn.into_iter().map(|(_, _, r)| r).collect();
+    written.push(opts.write_json("flat_scene", &records)?);
+    Ok(written)
 }
 
-/// The shared legend, a panel of its own.
-fn legend() -> Panel {
-    let mut series = surface_legend(ALL_SURFACES);
+/// The legend shared by a figure's panels: the kinds of `surfaces`, the
+/// sensor, the paths and the marks.
+fn legend(surfaces: impl IntoIterator<Item = Surface>) -> Vec<Series> {
+    let mut series = surface_legend(surfaces);
     series.extend([
         Series::polygon("sensor", colors::SENSOR, vec![], 1.0),
         Series::thin(
@@ -492,12 +556,7 @@ fn legend() -> Panel {
         Series::circles("moving silhouette corner in view", colors::MARK, vec![]),
         Series::circles("other moving corner in view", colors::STILL, vec![]),
     ]);
-    Panel {
-        title: format!("{PATHS} backward paths per scene"),
-        series,
-        legend_only: true,
-        ..Panel::default()
-    }
+    series
 }
 
 #[cfg(test)]

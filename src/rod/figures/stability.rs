@@ -290,7 +290,7 @@ fn panel(cells: &[&Cell], thicknesses: &[f64], title: String) -> Panel {
         title,
         x_label: "x / length (non-uniform grid)".into(),
         x_tick_names: position_names(),
-        tick_size: Some(13),
+        tick_size: Some(14),
         y_label: "optical thickness κe × length".into(),
         y_tick_names: thicknesses.iter().map(|&t| two_digits(t)).collect(),
         series: vec![
@@ -332,8 +332,36 @@ fn legend(record: &Record) -> Panel {
     bar
 }
 
-/// Writes `stability.{png,svg}` (the coverage of every cell, markers where
-/// the diagnostic flags most runs or most runs report `σ = 0`) and
+/// The figure of one method: its coverage over (position, thickness), one
+/// row per albedo and one column per direction, the colour bar last.
+fn method_figure(record: &Record, thicknesses: &[f64], method: Method) -> Figure {
+    let mut panels = Vec::new();
+    for &albedo in &ALBEDOS {
+        for omega in [Direction::Left, Direction::Right] {
+            let of_panel: Vec<&Cell> = record
+                .cells
+                .iter()
+                .filter(|c| {
+                    c.method == method.name() && c.omega == omega.sign() && c.albedo == albedo
+                })
+                .collect();
+            let going = match omega {
+                Direction::Left => "−1, left-going",
+                Direction::Right => "+1, right-going",
+            };
+            let title = format!("{}: ω = {going}, λ = {albedo}", method.name());
+            panels.push(panel(&of_panel, thicknesses, title));
+        }
+    }
+    panels.push(legend(record));
+    let mut figure = Figure::new(panels, 2);
+    figure.panel_size = (560, 300);
+    figure
+}
+
+/// Writes `stability_{expectation,rendering,transport}.{png,svg}`, one
+/// figure per method (the coverage of every cell, markers where the
+/// diagnostic flags most runs or most runs report `σ = 0`), and
 /// `stability.json` (every cell's numbers).
 pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let thicknesses = thicknesses();
@@ -347,31 +375,11 @@ pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         paths: opts.paths(PATHS),
         cells,
     };
-    let mut panels = Vec::new();
+    let mut written = Vec::new();
     for method in METHODS {
-        for omega in [Direction::Left, Direction::Right] {
-            for &albedo in &ALBEDOS {
-                let of_panel: Vec<&Cell> = record
-                    .cells
-                    .iter()
-                    .filter(|c| {
-                        c.method == method.name() && c.omega == omega.sign() && c.albedo == albedo
-                    })
-                    .collect();
-                let sign = if omega == Direction::Right {
-                    "+"
-                } else {
-                    "−"
-                };
-                let title = format!("{}, ω = {sign}1, λ = {albedo}", method.name());
-                panels.push(panel(&of_panel, &thicknesses, title));
-            }
-        }
+        let figure = method_figure(&record, &thicknesses, method);
+        written.extend(figure.save(&opts.out, &format!("stability_{}", method.name()))?);
     }
-    panels.push(legend(&record));
-    let mut figure = Figure::new(panels, ALBEDOS.len());
-    figure.panel_size = (540, 340);
-    let mut written = figure.save(&opts.out, "stability")?;
     written.push(opts.write_json("stability", &record)?);
     Ok(written)
 }
@@ -404,7 +412,18 @@ mod tests {
         };
         let written = stability(&opts).unwrap();
         let names: Vec<_> = written.iter().filter_map(|p| p.file_name()).collect();
-        assert_eq!(names, ["stability.png", "stability.svg", "stability.json"]);
+        assert_eq!(
+            names,
+            [
+                "stability_expectation.png",
+                "stability_expectation.svg",
+                "stability_rendering.png",
+                "stability_rendering.svg",
+                "stability_transport.png",
+                "stability_transport.svg",
+                "stability.json"
+            ]
+        );
         let json = std::fs::read_to_string(dir.join("stability.json")).unwrap();
         let cells = serde_json::from_str::<serde_json::Value>(&json).unwrap()["cells"]
             .as_array()
