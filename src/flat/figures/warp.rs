@@ -221,7 +221,7 @@ fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel 
             let label = if labelled {
                 ""
             } else {
-                "t·V(φ)·ω⊥ where the ray hits"
+                "t·V(φ)·η⊥ where the ray hits"
             };
             labelled = true;
             series.push(Series::line(
