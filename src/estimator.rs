@@ -13,6 +13,19 @@ use crate::stats::{ChunkSums, StratumSums};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
+/// The relative size below which a weight is the rounding residue of terms
+/// that cancel exactly, not a signal: about 450 units of roundoff. A slab
+/// translated along its own faces, for one, gives entry and exit terms equal
+/// and opposite, and their computed difference (or the speed of a face
+/// relative to a vertex that moves with it, or a central difference of two
+/// paths that differ only by the rounding of the displaced geometry) is a
+/// few units of roundoff of the terms. Reported as is, such weights make a
+/// derivative that is exactly 0 read "−4e-18 ± 3e-20, reliable", a z-score
+/// of 150 against the truth; set to 0, it reads "0 ± 0", flagged as
+/// resting on no non-zero weight. A genuine weight that small beside its
+/// terms would itself be mostly rounding.
+pub const ROUNDING: f64 = 1e-13;
+
 /// What one weight slot estimates.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(tag = "kind", content = "name", rename_all = "snake_case")]

@@ -13,6 +13,7 @@
 use super::rendering::Rendering;
 use super::walk::{Vertex, light_sample, transmittance};
 use super::{Boundaries, Geometry, Hit, Vector};
+use crate::estimator::ROUNDING;
 use crate::rng::PathRng;
 
 /// Most derivative slots a walk carries (shape parameters plus the sensor's
@@ -98,8 +99,13 @@ pub struct Slot<V: Vector> {
     pub wd: V,
     /// Running score `Λ_j`.
     pub score: f64,
+    /// Σ|terms| of the score: what its rounding error is relative to.
+    pub score_scale: f64,
     /// Boundary terms collected so far (and, at the end, the derivative).
     pub boundary: f64,
+    /// Σ|terms| of `boundary` (a term's own scale where it carries one):
+    /// a derivative below [`ROUNDING`] times it is rounding, not signal.
+    pub boundary_scale: f64,
     /// `ṫ_b` of the current segment.
     pub tb_dot: f64,
     /// Turn rate of the current vertex's frame (scratch for the methods).
@@ -107,11 +113,39 @@ pub struct Slot<V: Vector> {
 }
 
 impl<V: Vector> Slot<V> {
+    /// Adds `t` to the score.
+    #[inline]
+    pub fn add_score(&mut self, t: f64) {
+        self.score += t;
+        self.score_scale += t.abs();
+    }
+
+    /// Adds `t` to the boundary terms, `scale` being the size of what `t`
+    /// was computed from (`|t|` for a term of its own).
+    #[inline]
+    pub fn add_boundary(&mut self, t: f64, scale: f64) {
+        self.boundary += t;
+        self.boundary_scale += scale;
+    }
+
+    /// The derivative collected: `boundary`, or 0 where it is below the
+    /// rounding of its terms ([`ROUNDING`]).
+    #[inline]
+    pub fn derivative(&self) -> f64 {
+        if self.boundary.abs() <= ROUNDING * self.boundary_scale {
+            0.0
+        } else {
+            self.boundary
+        }
+    }
+
     const ZERO: Self = Slot {
         u: V::ZERO,
         wd: V::ZERO,
         score: 0.0,
+        score_scale: 0.0,
         boundary: 0.0,
+        boundary_scale: 0.0,
         tb_dot: 0.0,
         spin: V::STILL,
     };
@@ -157,6 +191,7 @@ impl<V: Vector> Deform<V> {
         }
         for s in &mut self.slots {
             s.boundary = 0.0;
+            s.boundary_scale = 0.0;
         }
         self.live = SlotSet::EMPTY;
     }
@@ -205,7 +240,16 @@ impl<V: Vector> Deform<V> {
                 V::ZERO
             };
             let s = &mut self.slots[j];
-            s.tb_dot = (v - s.u - s.wd * h.t).dot(n) / wn;
+            let along = (v - s.u - s.wd * h.t).dot(n);
+            // A boundary that moves with the vertex (a slab's far face, the
+            // slab translated along its normal) leaves only the rounding of
+            // the speeds subtracted: that is 0, not a tiny signal.
+            let speeds = v.length() + s.u.length() + s.wd.length() * h.t;
+            s.tb_dot = if along.abs() <= ROUNDING * speeds {
+                0.0
+            } else {
+                along / wn
+            };
             if s.tb_dot != 0.0 {
                 self.live.insert(j);
             }
@@ -265,7 +309,7 @@ impl<V: Vector> Deform<V> {
     pub fn pass(&mut self, rule: SlotSet, ke: f64) {
         for j in self.live.and(rule).iter() {
             let s = &mut self.slots[j];
-            s.score -= ke * s.tb_dot;
+            s.add_score(-ke * s.tb_dot);
         }
     }
 
@@ -275,7 +319,7 @@ impl<V: Vector> Deform<V> {
     pub fn collect(&mut self, contribution: f64) {
         for j in self.live.iter() {
             let s = &mut self.slots[j];
-            s.boundary += contribution * s.score;
+            s.add_boundary(contribution * s.score, (contribution * s.score_scale).abs());
         }
     }
 }
@@ -438,7 +482,8 @@ pub fn connect<G: Boundaries>(
     } = follow;
     if contribution != 0.0 {
         for j in tmp.live.iter() {
-            d.slots[j].boundary += contribution * tmp.slots[j].score;
+            let t = &tmp.slots[j];
+            d.slots[j].add_boundary(contribution * t.score, (contribution * t.score_scale).abs());
         }
     }
     scratch.give(tmp);

@@ -146,7 +146,7 @@ impl<G: Boundaries> DerivativeEstimator<G> {
         };
         out[0] = i;
         for (o, s) in out[1..].iter_mut().zip(&d.slots) {
-            *o = scale * s.boundary;
+            *o = scale * s.derivative();
         }
         scratch.give(d);
     }

@@ -50,7 +50,8 @@ fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>
             }
         };
         let (wd, div) = g.warp_velocity(&field, j, v.x, w, s.u, s.spin, velocity);
-        s.score += div + v.lobe.dlog(w, wd - G::V::turn(s.spin, w));
+        s.add_score(div);
+        s.add_score(v.lobe.dlog(w, wd - G::V::turn(s.spin, w)));
         s.wd = wd;
     }
     for j in involved.iter() {
@@ -83,9 +84,9 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
         // The free path stretches with its domain [0, t_b].
         for j in self.d.live.iter() {
             let s = &mut self.d.slots[j];
-            s.score += s.tb_dot / t_b;
+            s.add_score(s.tb_dot / t_b);
             let xi_dot = xi / t_b * s.tb_dot;
-            s.score -= ke * xi_dot;
+            s.add_score(-ke * xi_dot);
             s.u = s.u + w * xi_dot + s.wd * xi;
         }
     }

@@ -123,7 +123,7 @@ pub(super) fn leibniz<G: Geometry>(
     let term = beta * ks * (-ke * t_b).exp() * ls;
     for j in moving.iter() {
         let s = &mut d.slots[j];
-        s.boundary += term * s.tb_dot;
+        s.add_boundary(term * s.tb_dot, (term * s.tb_dot).abs());
     }
 }
 // ANCHOR_END: leibniz
@@ -203,7 +203,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     let term = v.beta * f * t * (l_behind - l_ahead) * b.inv_pdf;
     for j in involved.iter() {
         let s = &mut d.slots[j];
-        s.boundary += term * s.tb_dot;
+        s.add_boundary(term * s.tb_dot, (term * s.tb_dot).abs());
         s.tb_dot = 0.0;
     }
 }

@@ -79,7 +79,8 @@ impl<G: Boundaries> Transport<'_, G> {
         let start = y - w * (1e-9 * g.size()).min(0.5 * (y - x).length());
         let nested = self.frozen_walk(g, rng, nested, start, w, medium, NO_PRIM, drawn);
         for j in self.slots.parameter_slots.iter() {
-            self.d.slots[j].boundary -= beta * nested.slots[j].boundary;
+            let n = &nested.slots[j];
+            self.d.slots[j].add_boundary(-beta * n.boundary, (beta * n.boundary_scale).abs());
         }
         self.scratch.give(nested);
     }
@@ -171,8 +172,9 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
         let dke = ke(before) - ke(after);
         for j in self.slots.parameter_slots.iter() {
             let s = &mut self.d.slots[j];
-            s.boundary += beta * s.tb_dot * scattered;
-            s.score -= dke * s.tb_dot;
+            let t = beta * s.tb_dot * scattered;
+            s.add_boundary(t, t.abs());
+            s.add_score(-dke * s.tb_dot);
             if s.score != 0.0 {
                 self.d.live.insert(j);
             }
@@ -221,7 +223,9 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             let drawn = Some((super::Lobe::pdf(&v.lobe, w), v.x));
             let nested = self.frozen_walk(g, rng, nested, v.x, w, v.medium, v.skip, drawn);
             for j in params.iter() {
-                self.d.slots[j].boundary += v.beta * nested.slots[j].boundary;
+                let n = &nested.slots[j];
+                self.d.slots[j]
+                    .add_boundary(v.beta * n.boundary, (v.beta * n.boundary_scale).abs());
             }
             self.scratch.give(nested);
             self.moving_reflector = false;
