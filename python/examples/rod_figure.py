@@ -8,8 +8,8 @@ rendering, expectation differentiation, the transport model, central finite
 differences, whose probe stays inside the rod: x < 2); columns: the paper's thin rod (κs = 0.07, κe = 0.1) and thick
 rod (κs = 2.1, κe = 3), length 2. Each panel: the estimates at 21 positions,
 both directions, with ±σ error bars, over the exact curves
-(``method="exact"``). Needs matplotlib (``pip install matplotlib``); about
-ten seconds on two cores with the default 100000 paths per point.
+(``method="exact"``). Needs matplotlib (``pip install matplotlib``); a few
+seconds on two cores with the default 100000 paths per point.
 """
 
 from __future__ import annotations
