@@ -105,3 +105,26 @@ def test_shard_errors(cli, tmp_path):
         geosens.flat(OCC, "expectation", shard=(0, 4))
     with pytest.raises(ValueError, match=r"shard 5/4: expected I/N"):
         geosens.render(LINE, "expectation", shard=(5, 4))
+
+
+def test_render_state_files_merge_as_the_command_line(cli, tmp_path):
+    """The CLI's rendering states merged in Python: its JSON line and, bit for
+    bit, the .npy images `geosens merge --out` writes."""
+    import numpy as np
+
+    files = []
+    for i in (1, 2):
+        f = tmp_path / f"r{i}.json"
+        cli.run("render", "--scene", LINE, "--method", "expectation", "--spp", 32,
+                "--seed", 9, "--shard", f"{i}/2", "--state", f)
+        files.append(f)
+    out = tmp_path / "merged"
+    ref = json.loads(cli.run("merge", *files, "--out", out).stdout)
+    py = geosens.merge(files)
+    assert_same(py, ref)
+    single = geosens.render(LINE, "expectation", spp=32, seed=9)
+    assert image_bytes(py) == image_bytes(single)
+    for key, img in py["images"].items():
+        stem = "I" if key == "I" else f"d_{key}"
+        assert img["mean"].tobytes() == np.load(out / f"{stem}.npy").tobytes()
+        assert img["stderr"].tobytes() == np.load(out / f"{stem}_stderr.npy").tobytes()
