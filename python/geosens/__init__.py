@@ -1,0 +1,303 @@
+"""Monte Carlo estimates of intensity and geometric sensitivities.
+
+The Python face of the geosens command line: each function runs what its
+subcommand runs and returns what ``--json`` prints, parsed::
+
+    >>> import geosens
+    >>> r = geosens.rod("expectation", 0.07, 0.1, 2.0, 1.0, 1.0, paths=100_000)
+    >>> r["sensitivity"]["mean"], r["sensitivity"]["stderr"]
+
+- :func:`rod`, :func:`flat`, :func:`mesh` return the dict of the command
+  line's JSON line (``geosens rod|flat|mesh ... --json``), identical bit for
+  bit for the same seed but for ``"seconds"``;
+- :func:`render` returns the JSON line of ``geosens render`` with the images
+  added under ``"images"`` as float64 arrays of shape (height, width);
+- with ``shard=(i, n)`` each returns shard ``i`` of ``n`` of the run instead:
+  its exact state, a dict (``--shard i/n --state FILE``), and :func:`merge`
+  turns the states of all ``n`` shards into what the single run returns.
+
+A scene is a file (TOML or JSON, a ``str`` or ``os.PathLike``) or a dict with
+the file's schema, so that a notebook can sweep a parameter by editing it
+(OBJ paths in a dict are relative to the current directory). Bad input
+raises :class:`ValueError` with the command line's message; the estimator's
+caveats are issued as :class:`RuntimeWarning`. The GIL is released while
+paths are sampled, so other Python threads run meanwhile.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import warnings
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _geosens
+
+__all__ = ["rod", "flat", "mesh", "render", "merge", "__version__"]
+
+__version__: str = _geosens.__version__
+
+#: A scene: a TOML or JSON file, or a dict of the file's schema.
+Scene = Union[str, "os.PathLike[str]", Dict[str, Any]]
+#: A shard of a run: ``(i, n)``, 1 ≤ i ≤ n.
+ShardSpec = Tuple[int, int]
+#: A shard's state: its dict, its JSON text, or the file the command line's
+#: ``--state`` wrote.
+StateLike = Union[Dict[str, Any], str, "os.PathLike[str]"]
+
+
+def _uint(name: str, value: Any) -> int:
+    """``value`` if it is an integer ≥ 0, else ValueError (Rust takes u64)."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(
+            f"invalid value {value!r} for {name}: expected an integer ≥ 0"
+        )
+    return value
+
+
+def _shard(shard: Optional[ShardSpec]) -> Optional[Tuple[int, int]]:
+    if shard is None:
+        return None
+    try:
+        i, n = shard
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"shard {shard!r}: expected (i, n) with 1 ≤ i ≤ n"
+        ) from None
+    return (_uint("shard index", i), _uint("shard count", n))
+
+
+def _fd_step(fd_step: Optional[float]) -> Optional[float]:
+    return None if fd_step is None else float(fd_step)
+
+
+def _scene(scene: Scene) -> Tuple[Optional[str], Optional[str]]:
+    """The scene as (file, None) or (None, JSON text)."""
+    if isinstance(scene, dict):
+        return None, json.dumps(scene)
+    if isinstance(scene, (str, os.PathLike)):
+        return os.fspath(scene), None
+    raise ValueError(
+        f"a scene is a file path or a dict, not {type(scene).__name__}"
+    )
+
+
+def _result(outcome: Tuple[str, str, List[str], list]) -> Dict[str, Any]:
+    """The Python result of a Rust call: its JSON parsed, its warnings
+    issued, a rendering's images as arrays."""
+    kind, text, warns, images = outcome
+    for w in warns:
+        warnings.warn(w.removeprefix("warning: "), RuntimeWarning, stacklevel=3)
+    result = json.loads(text)
+    if kind == "image":
+        result["images"] = {
+            key: {
+                "mean": np.frombuffer(mean, dtype=np.float64).reshape(h, w),
+                "stderr": np.frombuffer(stderr, dtype=np.float64).reshape(h, w),
+            }
+            for key, h, w, mean, stderr in images
+        }
+    return result
+
+
+def rod(
+    method: str,
+    ks: float,
+    ke: float,
+    length: float,
+    x: float,
+    omega: float,
+    *,
+    paths: int = 1_000_000,
+    seed: int = 1,
+    threads: int = 0,
+    fd_step: Optional[float] = None,
+    shard: Optional[ShardSpec] = None,
+) -> Dict[str, Any]:
+    """``geosens rod --json``: I, ∂I/∂length (and ∂I/∂x) at a probe on a rod.
+
+    Args:
+        method: ``"exact"`` (the Bellman–Wing solution, nothing sampled) or
+            one of intensity, expectation, rendering, transport, fd.
+        ks: scattering coefficient κs ≥ 0.
+        ke: extinction coefficient κe ≥ κs.
+        length: the rod's length π̃ > 0, the shape parameter.
+        x: probe position, 0 ≤ x ≤ length.
+        omega: probe direction, 1 (right) or -1 (left).
+        paths: paths of the run (at least 2, checked for ``exact`` too).
+        seed: seed of the random streams.
+        threads: worker threads, 0 = all cores (results do not depend on it).
+        fd_step: half step of ``fd`` (relative to the length).
+        shard: ``(i, n)``: run shard i of n and return its state.
+
+    Returns:
+        ``{"method", "intensity", "sensitivity", "gradient_x", "paths",
+        "seconds"}``, each quantity ``{"mean", "stderr", "nonzero",
+        "reliable"}`` or None if the method does not estimate it; or, with
+        ``shard``, the shard's state.
+
+    Raises:
+        ValueError: bad input, with the command line's message.
+    """
+    return _result(
+        _geosens.rod(
+            method,
+            float(ks),
+            float(ke),
+            float(length),
+            float(x),
+            float(omega),
+            _uint("paths", paths),
+            _uint("seed", seed),
+            _uint("threads", threads),
+            _fd_step(fd_step),
+            _shard(shard),
+        )
+    )
+
+
+def _scene_run(
+    mesh: bool,
+    scene: Scene,
+    method: str,
+    paths: int,
+    seed: int,
+    threads: int,
+    fd_step: Optional[float],
+    shard: Optional[ShardSpec],
+) -> Dict[str, Any]:
+    path, text = _scene(scene)
+    return _result(
+        _geosens.scene(
+            mesh,
+            path,
+            text,
+            method,
+            _uint("paths", paths),
+            _uint("seed", seed),
+            _uint("threads", threads),
+            _fd_step(fd_step),
+            _shard(shard),
+        )
+    )
+
+
+def flat(
+    scene: Scene,
+    method: str,
+    *,
+    paths: int = 1_000_000,
+    seed: int = 1,
+    threads: int = 0,
+    fd_step: Optional[float] = None,
+    shard: Optional[ShardSpec] = None,
+) -> Dict[str, Any]:
+    """``geosens flat --json``: I and every ∂I/∂π of a flatland scene.
+
+    Args:
+        scene: a scene file (TOML or JSON) or a dict of its schema.
+        method: intensity, expectation, rendering, transport or fd.
+        paths, seed, threads, fd_step, shard: as for :func:`rod`.
+
+    Returns:
+        ``{"method", "intensity", "sensitivity": {param: …}, "gradient"
+        (transport's ∂I/∂x, ∂I/∂y, else None), "paths", "seconds"}``; or,
+        with ``shard``, the shard's state.
+
+    Raises:
+        ValueError: bad input, with the command line's message.
+    """
+    return _scene_run(False, scene, method, paths, seed, threads, fd_step, shard)
+
+
+def mesh(
+    scene: Scene,
+    method: str,
+    *,
+    paths: int = 1_000_000,
+    seed: int = 1,
+    threads: int = 0,
+    fd_step: Optional[float] = None,
+    shard: Optional[ShardSpec] = None,
+) -> Dict[str, Any]:
+    """``geosens mesh --json``: I and every ∂I/∂π of a 3D scene.
+
+    As :func:`flat`; transport's gradient has the axes x, y, z.
+    """
+    return _scene_run(True, scene, method, paths, seed, threads, fd_step, shard)
+
+
+def render(
+    scene: Scene,
+    method: str,
+    *,
+    spp: int = 64,
+    seed: int = 1,
+    threads: int = 0,
+    fd_step: Optional[float] = None,
+    shard: Optional[ShardSpec] = None,
+) -> Dict[str, Any]:
+    """``geosens render``: every pixel of a camera scene (3D, or flatland's
+    line camera), ``spp`` paths per pixel.
+
+    Returns:
+        The command line's JSON line (``"method"``, ``"I"``,
+        ``"sensitivity"``: the images' mean pixel values with their standard
+        errors, ``"width"``, ``"height"``, ``"paths"``, ``"seconds"``) and
+        ``"images"``: ``{"I": {"mean": array, "stderr": array}, param: {…},
+        …}``, float64 arrays of shape (height, width), row 0 at the top (the
+        command line's ``I.npy``, ``I_stderr.npy``, ``d_<param>.npy``, …);
+        or, with ``shard`` (a share of the rows), the shard's state.
+
+    Raises:
+        ValueError: bad input, with the command line's message.
+    """
+    path, text = _scene(scene)
+    return _result(
+        _geosens.render(
+            path,
+            text,
+            method,
+            _uint("spp", spp),
+            _uint("seed", seed),
+            _uint("threads", threads),
+            _fd_step(fd_step),
+            _shard(shard),
+        )
+    )
+
+
+def merge(states: Sequence[StateLike]) -> Dict[str, Any]:
+    """``geosens merge``: the states of every shard of one run, in any
+    order, merged into what the single run returns, bit for bit (for a
+    rendering, with its images); ``"seconds"`` is the sum of the shards'.
+
+    Args:
+        states: each a state dict (what a function returns with
+            ``shard``), its JSON text, or a state file written by the command
+            line's ``--state``. A ``str`` that does not start with ``{`` is a
+            file.
+
+    Raises:
+        ValueError: the states are not every shard of one run, each once
+            (the message names them: a file by its path, others as
+            ``states[k]``).
+    """
+    if isinstance(states, (str, dict, os.PathLike)):
+        raise ValueError("merge takes a list of states")
+    items = []
+    for k, s in enumerate(states):
+        if isinstance(s, dict):
+            items.append((f"states[{k}]", None, json.dumps(s)))
+        elif isinstance(s, str) and s.lstrip().startswith("{"):
+            items.append((f"states[{k}]", None, s))
+        elif isinstance(s, (str, os.PathLike)):
+            items.append((os.fspath(s), os.fspath(s), None))
+        else:
+            raise ValueError(
+                f"states[{k}]: a state is a dict, JSON text or a file, "
+                f"not {type(s).__name__}"
+            )
+    return _result(_geosens.merge(items))

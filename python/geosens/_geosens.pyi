@@ -1,0 +1,23 @@
+# The Rust module (python/src/lib.rs); `geosens/__init__.py` wraps it.
+from typing import List, Optional, Tuple
+
+# (kind, JSON text, warnings, images): kind is "report", "image" or "state";
+# an image is (key, height, width, mean bytes, stderr bytes), native float64.
+_Outcome = Tuple[str, str, List[str], List[Tuple[str, int, int, bytes, bytes]]]
+
+__version__: str
+
+def rod(
+    method: str, ks: float, ke: float, length: float, x: float, omega: float,
+    paths: int, seed: int, threads: int, fd_step: Optional[float],
+    shard: Optional[Tuple[int, int]],
+) -> _Outcome: ...
+def scene(
+    mesh: bool, path: Optional[str], json: Optional[str], method: str, paths: int,
+    seed: int, threads: int, fd_step: Optional[float], shard: Optional[Tuple[int, int]],
+) -> _Outcome: ...
+def render(
+    path: Optional[str], json: Optional[str], method: str, spp: int, seed: int,
+    threads: int, fd_step: Optional[float], shard: Optional[Tuple[int, int]],
+) -> _Outcome: ...
+def merge(states: List[Tuple[str, Optional[str], Optional[str]]]) -> _Outcome: ...

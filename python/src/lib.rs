@@ -1,0 +1,274 @@
+//! `geosens._geosens`: the Rust side of the `geosens` Python package, a thin
+//! layer over the library's jobs ([`geosens::job`]), printing
+//! ([`geosens::report`]) and shards ([`geosens::shard`]). Every function
+//! returns the same JSON text as the command line's `--json` line (or a
+//! shard's state), which `geosens/__init__.py` turns into Python objects;
+//! every bad input raises `ValueError` with the library's message, the one
+//! the command line prints after `error: `. The GIL is released while
+//! sampling.
+use geosens::image::ImageResult;
+use geosens::job::{ImageReport, Job, RenderJob, SceneSource, Target};
+use geosens::report::Report;
+use geosens::runner::MAX_THREADS;
+use geosens::shard::{Merged, Shard, State, merge as merge_states};
+use geosens::{Error, Method, Quantity, RunConfig};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use std::path::PathBuf;
+
+/// One image of a rendering as Python gets it: its key (`I`, or the
+/// parameter's name), height, width, and the bytes of its means and standard
+/// errors (native-endian `f64`, row-major).
+type Image = (String, u32, u32, Py<PyBytes>, Py<PyBytes>);
+
+/// What every function returns: the kind (`"report"`: the JSON line of
+/// `rod`, `flat` or `mesh`; `"image"`: the JSON line of `render`; `"state"`:
+/// a shard's state), the JSON text, the warnings the command line prints on
+/// stderr, and a rendering's images (empty otherwise).
+type Outcome = (&'static str, String, Vec<String>, Vec<Image>);
+
+/// What a run gives before it becomes Python objects (built without the
+/// GIL).
+enum Output {
+    Report(Report),
+    Image(ImageReport),
+    State(State),
+}
+
+/// `e` as the `ValueError` Python raises, with the command line's message.
+fn value_error(e: Error) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+impl Output {
+    /// The JSON text, warnings and images, as [`Outcome`].
+    fn into_py(self, py: Python<'_>) -> Result<Outcome, Error> {
+        Ok(match self {
+            Output::Report(r) => ("report", r.json()?, r.warnings(), Vec::new()),
+            Output::Image(r) => ("image", r.json()?, r.warnings(), images(py, &r.result)),
+            Output::State(s) => ("state", s.to_json()?, Vec::new(), Vec::new()),
+        })
+    }
+}
+
+/// The images of `r` as [`Image`]s, in the estimator's order.
+fn images(py: Python<'_>, r: &ImageResult) -> Vec<Image> {
+    let bytes = |f: &dyn Fn(&geosens::Estimate) -> f64, img: &[geosens::Estimate]| {
+        let b: Vec<u8> = img.iter().flat_map(|e| f(e).to_ne_bytes()).collect();
+        PyBytes::new(py, &b).unbind()
+    };
+    r.images
+        .iter()
+        .map(|(q, img)| {
+            let key = match q {
+                Quantity::Intensity => "I".to_owned(),
+                Quantity::Sensitivity(p) => p.clone(),
+                Quantity::Gradient(_) => q.to_string(),
+            };
+            (
+                key,
+                r.height,
+                r.width,
+                bytes(&|e| e.mean, img),
+                bytes(&|e| e.stderr, img),
+            )
+        })
+        .collect()
+}
+
+/// Errors unless `threads ≤ MAX_THREADS`, as the command line checks before
+/// anything else (the runner checks it too, but the rod's exact solution
+/// runs no runner).
+fn check_threads(threads: usize) -> Result<(), Error> {
+    if threads > MAX_THREADS {
+        return Err(Error::Config(format!(
+            "threads = {threads}: expected 0 (all cores) to {MAX_THREADS}"
+        )));
+    }
+    Ok(())
+}
+
+/// The scene: a file, or the file's schema as JSON text.
+fn source(path: Option<PathBuf>, json: Option<String>) -> PyResult<SceneSource> {
+    match (path, json) {
+        (Some(p), None) => Ok(SceneSource::File(p)),
+        (None, Some(text)) => Ok(SceneSource::Json(text)),
+        _ => Err(PyValueError::new_err(
+            "the scene is either a file or JSON text",
+        )),
+    }
+}
+
+/// Runs `job` on `paths` paths, or its shard `shard = (i, n)`, without the
+/// GIL.
+fn estimate(
+    py: Python<'_>,
+    job: Job,
+    paths: u64,
+    seed: u64,
+    threads: usize,
+    shard: Option<(u64, u64)>,
+) -> PyResult<Outcome> {
+    let out = py.detach(|| -> Result<Output, Error> {
+        check_threads(threads)?;
+        let cfg = RunConfig::new(paths, seed)?.threads(threads);
+        match shard {
+            None => job.run(&cfg).map(Output::Report),
+            Some((i, n)) => job.run_shard(&cfg, Shard::new(i, n)?).map(Output::State),
+        }
+    });
+    out.and_then(|o| o.into_py(py)).map_err(value_error)
+}
+
+/// `geosens rod`: `method` is a method's name or `exact`.
+#[pyfunction]
+#[pyo3(signature = (method, ks, ke, length, x, omega, paths, seed, threads, fd_step, shard))]
+#[allow(clippy::too_many_arguments)]
+fn rod(
+    py: Python<'_>,
+    method: &str,
+    ks: f64,
+    ke: f64,
+    length: f64,
+    x: f64,
+    omega: f64,
+    paths: u64,
+    seed: u64,
+    threads: usize,
+    fd_step: Option<f64>,
+    shard: Option<(u64, u64)>,
+) -> PyResult<Outcome> {
+    // `exact` beside the methods, as the command line's `--method` lists
+    // them.
+    let method = match method {
+        "exact" => None,
+        m => Some(m.parse::<Method>().map_err(|_| {
+            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            value_error(Error::Config(format!(
+                "unknown method {m:?}: expected one of exact, {}",
+                names.join(", ")
+            )))
+        })?),
+    };
+    let job = Job {
+        target: Target::Rod {
+            ks,
+            ke,
+            length,
+            x,
+            omega,
+        },
+        method,
+        fd_step,
+    };
+    estimate(py, job, paths, seed, threads, shard)
+}
+
+/// `geosens flat` (`mesh = false`) or `geosens mesh` on a scene file
+/// (`path`) or JSON text (`json`).
+#[pyfunction]
+#[pyo3(signature = (mesh, path, json, method, paths, seed, threads, fd_step, shard))]
+#[allow(clippy::too_many_arguments)]
+fn scene(
+    py: Python<'_>,
+    mesh: bool,
+    path: Option<PathBuf>,
+    json: Option<String>,
+    method: &str,
+    paths: u64,
+    seed: u64,
+    threads: usize,
+    fd_step: Option<f64>,
+    shard: Option<(u64, u64)>,
+) -> PyResult<Outcome> {
+    let method = method.parse::<Method>().map_err(value_error)?;
+    let source = source(path, json)?;
+    let job = Job {
+        target: if mesh {
+            Target::Mesh(source)
+        } else {
+            Target::Flat(source)
+        },
+        method: Some(method),
+        fd_step,
+    };
+    estimate(py, job, paths, seed, threads, shard)
+}
+
+/// `geosens render` on a scene file (`path`) or JSON text (`json`), or its
+/// shard `shard = (i, n)`.
+#[pyfunction]
+#[pyo3(signature = (path, json, method, spp, seed, threads, fd_step, shard))]
+#[allow(clippy::too_many_arguments)]
+fn render(
+    py: Python<'_>,
+    path: Option<PathBuf>,
+    json: Option<String>,
+    method: &str,
+    spp: u64,
+    seed: u64,
+    threads: usize,
+    fd_step: Option<f64>,
+    shard: Option<(u64, u64)>,
+) -> PyResult<Outcome> {
+    let method = method.parse::<Method>().map_err(value_error)?;
+    let job = RenderJob {
+        scene: source(path, json)?,
+        method,
+        fd_step,
+    };
+    let out = py.detach(|| -> Result<Output, Error> {
+        check_threads(threads)?;
+        match shard {
+            None => job.run(spp, seed, threads, &|_| {}).map(Output::Image),
+            Some((i, n)) => job
+                .run_shard(spp, seed, threads, Shard::new(i, n)?, &|_| {})
+                .map(Output::State),
+        }
+    });
+    out.and_then(|o| o.into_py(py)).map_err(value_error)
+}
+
+/// `geosens merge`: `states` holds, per state, its name in messages and
+/// either its file or its JSON text.
+#[pyfunction]
+fn merge(
+    py: Python<'_>,
+    states: Vec<(String, Option<PathBuf>, Option<String>)>,
+) -> PyResult<Outcome> {
+    let out = py.detach(|| -> Result<Output, Error> {
+        let mut labelled = Vec::with_capacity(states.len());
+        for (name, path, text) in states {
+            // The command line's messages: a file that cannot be read, and
+            // a text that is not a state, named.
+            let text = match (path, text) {
+                (Some(p), _) => std::fs::read_to_string(p)
+                    .map_err(|e| Error::Merge(format!("cannot read {name}: {e}")))?,
+                (None, Some(t)) => t,
+                (None, None) => return Err(Error::Merge(format!("{name}: no state"))),
+            };
+            let state = State::from_json(&text).map_err(|e| match e {
+                Error::Merge(m) => Error::Merge(format!("{name}: {m}")),
+                other => other,
+            })?;
+            labelled.push((name, state));
+        }
+        Ok(match merge_states(&labelled)? {
+            Merged::Probe(r) => Output::Report(r),
+            Merged::Image(r) => Output::Image(r),
+        })
+    });
+    out.and_then(|o| o.into_py(py)).map_err(value_error)
+}
+
+/// The module `geosens._geosens`.
+#[pymodule]
+fn _geosens(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(rod, m)?)?;
+    m.add_function(wrap_pyfunction!(scene, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
