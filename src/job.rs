@@ -16,6 +16,25 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+/// Parses a method's name, or `exact` (the rod's exact solution, `None`)
+/// where `exact` is allowed; the error lists the names accepted.
+pub fn parse_method(name: &str, exact: bool) -> Result<Option<Method>, Error> {
+    if exact && name == "exact" {
+        return Ok(None);
+    }
+    name.parse::<Method>().map(Some).map_err(|_| {
+        let names: Vec<&str> = exact
+            .then_some("exact")
+            .into_iter()
+            .chain(Method::ALL.iter().map(|m| m.name()))
+            .collect();
+        Error::Config(format!(
+            "unknown method {name:?}: expected one of {}",
+            names.join(", ")
+        ))
+    })
+}
+
 /// Where a scene comes from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum SceneSource {
@@ -275,6 +294,7 @@ impl Job {
     /// Runs the job: what `geosens rod`, `flat` or `mesh` prints, as a
     /// [`Report`].
     pub fn run(&self, cfg: &RunConfig) -> Result<Report, Error> {
+        crate::runner::check_threads(cfg.threads)?;
         let prepared = self.prepare()?;
         let result = match &prepared.estimator {
             Some(est) => run(est.as_ref(), cfg)?,

@@ -100,7 +100,7 @@ impl RunResult {
 }
 
 /// Errors unless `threads ≤ MAX_THREADS`.
-pub(crate) fn check_threads(threads: usize) -> Result<(), Error> {
+pub fn check_threads(threads: usize) -> Result<(), Error> {
     if threads > MAX_THREADS {
         return Err(Error::Config(format!(
             "threads = {threads}: expected 0 (all cores) to {MAX_THREADS}"

@@ -236,6 +236,24 @@ impl State {
         serde_json::from_str(text).map_err(|e| Error::Merge(format!("a malformed state: {e}")))
     }
 
+    /// Reads the state `text` named `name` in messages (its file), with
+    /// the messages `geosens merge` prints: `NAME: not a geosens state …`.
+    pub fn named(name: &str, text: &str) -> Result<State, Error> {
+        State::from_json(text).map_err(|e| match e {
+            Error::Merge(m) => Error::Merge(format!("{name}: {m}")),
+            other => other,
+        })
+    }
+
+    /// Reads the state file at `path`; errors name it (`cannot read FILE:
+    /// …`, `FILE: not a geosens state …`).
+    pub fn read(path: &std::path::Path) -> Result<State, Error> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Merge(format!("cannot read {name}: {e}")))?;
+        State::named(&name, &text)
+    }
+
     /// The shard this state holds.
     pub fn shard(&self) -> Shard {
         Shard {

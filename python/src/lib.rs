@@ -9,7 +9,6 @@
 use geosens::image::ImageResult;
 use geosens::job::{ImageReport, Job, RenderJob, SceneSource, Target};
 use geosens::report::Report;
-use geosens::runner::MAX_THREADS;
 use geosens::shard::{Merged, Shard, State, merge as merge_states};
 use geosens::{Error, Method, Quantity, RunConfig};
 use pyo3::exceptions::PyValueError;
@@ -77,18 +76,6 @@ fn images(py: Python<'_>, r: &ImageResult) -> Vec<Image> {
         .collect()
 }
 
-/// Errors unless `threads ≤ MAX_THREADS`, as the command line checks before
-/// anything else (the runner checks it too, but the rod's exact solution
-/// runs no runner).
-fn check_threads(threads: usize) -> Result<(), Error> {
-    if threads > MAX_THREADS {
-        return Err(Error::Config(format!(
-            "threads = {threads}: expected 0 (all cores) to {MAX_THREADS}"
-        )));
-    }
-    Ok(())
-}
-
 /// The scene: a file, or the file's schema as JSON text.
 fn source(path: Option<PathBuf>, json: Option<String>) -> PyResult<SceneSource> {
     match (path, json) {
@@ -111,7 +98,6 @@ fn estimate(
     shard: Option<(u64, u64)>,
 ) -> PyResult<Outcome> {
     let out = py.detach(|| -> Result<Output, Error> {
-        check_threads(threads)?;
         let cfg = RunConfig::new(paths, seed)?.threads(threads);
         match shard {
             None => job.run(&cfg).map(Output::Report),
@@ -141,16 +127,7 @@ fn rod(
 ) -> PyResult<Outcome> {
     // `exact` beside the methods, as the command line's `--method` lists
     // them.
-    let method = match method {
-        "exact" => None,
-        m => Some(m.parse::<Method>().map_err(|_| {
-            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-            value_error(Error::Config(format!(
-                "unknown method {m:?}: expected one of exact, {}",
-                names.join(", ")
-            )))
-        })?),
-    };
+    let method = geosens::job::parse_method(method, true).map_err(value_error)?;
     let job = Job {
         target: Target::Rod {
             ks,
@@ -219,7 +196,7 @@ fn render(
         fd_step,
     };
     let out = py.detach(|| -> Result<Output, Error> {
-        check_threads(threads)?;
+        geosens::runner::check_threads(threads)?;
         match shard {
             None => job.run(spp, seed, threads, &|_| {}).map(Output::Image),
             Some((i, n)) => job
@@ -242,16 +219,11 @@ fn merge(
         for (name, path, text) in states {
             // The command line's messages: a file that cannot be read, and
             // a text that is not a state, named.
-            let text = match (path, text) {
-                (Some(p), _) => std::fs::read_to_string(p)
-                    .map_err(|e| Error::Merge(format!("cannot read {name}: {e}")))?,
-                (None, Some(t)) => t,
+            let state = match (path, text) {
+                (Some(p), _) => State::read(&p)?,
+                (None, Some(t)) => State::named(&name, &t)?,
                 (None, None) => return Err(Error::Merge(format!("{name}: no state"))),
             };
-            let state = State::from_json(&text).map_err(|e| match e {
-                Error::Merge(m) => Error::Merge(format!("{name}: {m}")),
-                other => other,
-            })?;
             labelled.push((name, state));
         }
         Ok(match merge_states(&labelled)? {

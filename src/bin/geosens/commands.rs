@@ -97,17 +97,7 @@ pub(super) fn merge_command(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let mut states = Vec::with_capacity(args.states.len());
     for path in &args.states {
-        let name = path.display().to_string();
-        let state = std::fs::read_to_string(path)
-            .map_err(|e| Error::Merge(format!("cannot read {name}: {e}")))
-            .and_then(|text| State::from_json(&text))
-            .map_err(|e| match e {
-                Error::Merge(m) if !m.starts_with("cannot read") => {
-                    Error::Merge(format!("{name}: {m}"))
-                }
-                other => other,
-            })?;
-        states.push((name, state));
+        states.push((path.display().to_string(), State::read(path)?));
     }
     match geosens::shard::merge(&states)? {
         Merged::Probe(report) => {
