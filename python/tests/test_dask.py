@@ -30,9 +30,9 @@ def test_shards_on_a_local_cluster_are_the_single_run():
     ) as cluster, distributed.Client(cluster) as client:
         with distributed.get_task_stream(client) as stream:
             merged = ex.flat_on_dask(
-                client, scene, "expectation", shards=5, paths=paths, seed=seed, threads=1
+                client, scene, "expectation", shards=4, paths=paths, seed=seed, threads=1
             )
         workers = {t["worker"] for t in stream.data}
     single = geosens.flat(SCENES / "occluder.toml", "expectation", paths=paths, seed=seed)
     assert_same(merged, single)
-    assert len(stream.data) == 5 and len(workers) == 2, workers
+    assert len(stream.data) == 4 and len(workers) == 2, workers

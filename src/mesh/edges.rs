@@ -11,8 +11,13 @@
 //! thin band:
 //!
 //! - [`EdgeTree::sample`]: an edge drawn by descending the tree, each child
-//!   chosen in proportion to its edges' total weight unless it is culled;
-//!   the probability of the edge drawn is the product of the choices, exact,
+//!   chosen in proportion to an estimate of its edges' contribution seen
+//!   from `x` unless it is culled: their total weight (length × dihedral
+//!   turn) over the squared distance to the node (an edge's boundary term
+//!   is its arc on the sphere, ∝ length / distance, times the speed of that
+//!   arc, ∝ 1 / distance), and in a leaf each edge's weight times its arc's
+//!   angle over its distance; the probability of the edge drawn is the
+//!   product of the choices, exact,
 //!   so the boundary terms stay unbiased (a dead end, both children culled,
 //!   draws nothing: only edges that cannot be discontinuities lose their
 //!   share);
@@ -47,6 +52,18 @@ struct Node {
     /// Left child (right = left + 1) or first edge.
     first: u32,
     count: u32,
+}
+
+/// An edge's estimated contribution seen from `x`: its weight (length ×
+/// turn) per unit length, times the angle its arc subtends, over its
+/// distance (the midpoint's, at least half its length).
+#[inline]
+fn edge_importance(e: &Edge, weight: f64, x: DVec3) -> f64 {
+    let (ra, rb) = (e.a - x, e.b - x);
+    let length = (e.b - e.a).length();
+    let angle = ra.cross(rb).length().atan2(ra.dot(rb));
+    let d = (0.5 * (ra + rb)).length().max(0.5 * length);
+    weight / length * angle / d
 }
 
 /// Per edge, what the tree needs: its faces' normals and whether it is
@@ -209,6 +226,20 @@ impl EdgeTree {
         !(front || back)
     }
 
+    /// A node's estimated contribution seen from `x`: its edges' weight
+    /// over the squared distance to its centre, the distance at least half
+    /// its box's diagonal (inside or near the box the estimate is only
+    /// bounded, not sharp: it stays positive and finite).
+    #[inline]
+    fn importance(&self, i: usize, x: DVec3) -> f64 {
+        let n = &self.nodes[i];
+        let centre = 0.5 * (n.lo + n.hi);
+        let d2 = (x - centre)
+            .length_squared()
+            .max(0.25 * (n.hi - n.lo).length_squared());
+        n.weight / d2
+    }
+
     /// An edge drawn from `x` with `u ∈ [0, 1)`: its index, the probability
     /// it was drawn with, and the uniform number left over (for the point on
     /// it). `None` if the tree is culled away.
@@ -230,19 +261,22 @@ impl EdgeTree {
             let n = self.nodes[i];
             if n.count > 0 {
                 let ids = &self.order[n.first as usize..(n.first + n.count) as usize];
-                let live = |e: u32| is_discontinuity(&edges[e as usize], &facts[e as usize], x);
-                let total: f64 = ids
-                    .iter()
-                    .filter(|&&e| live(e))
-                    .map(|&e| weights[e as usize])
-                    .sum();
-                if total <= 0.0 {
+                let mut leaf = [0.0; LEAF];
+                for (w, &e) in leaf.iter_mut().zip(ids) {
+                    if is_discontinuity(&edges[e as usize], &facts[e as usize], x) {
+                        *w = edge_importance(&edges[e as usize], weights[e as usize], x);
+                    }
+                }
+                let total: f64 = leaf.iter().sum();
+                if !(total > 0.0 && total.is_finite()) {
                     return None;
                 }
                 let s = (u * total).min(total * (1.0 - f64::EPSILON));
                 let mut acc = 0.0;
-                for &e in ids.iter().filter(|&&e| live(e)) {
-                    let w = weights[e as usize];
+                for (&w, &e) in leaf.iter().zip(ids) {
+                    if w <= 0.0 {
+                        continue;
+                    }
                     if s < acc + w || acc + w >= total {
                         let rest = ((s - acc) / w).clamp(0.0, 1.0 - f64::EPSILON);
                         return Some((e, p * w / total, rest));
@@ -253,17 +287,17 @@ impl EdgeTree {
             }
             let (l, r) = (n.first as usize, n.first as usize + 1);
             let wl = if self.open(l, x) {
-                self.nodes[l].weight
+                self.importance(l, x)
             } else {
                 0.0
             };
             let wr = if self.open(r, x) {
-                self.nodes[r].weight
+                self.importance(r, x)
             } else {
                 0.0
             };
             let total = wl + wr;
-            if total <= 0.0 {
+            if !(total > 0.0 && total.is_finite()) {
                 return None;
             }
             let pl = wl / total;
@@ -338,6 +372,83 @@ impl EdgeTree {
         } else {
             self.leaves_under(n.first as usize, f);
             self.leaves_under(n.first as usize + 1, f);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 200 open edges (always discontinuities) scattered in a box, and the
+    /// frequency with which a fine grid of `u` draws each against the
+    /// probability the draw reports: the descent's probabilities must be
+    /// those it samples with, whatever the importance.
+    #[test]
+    fn an_edge_is_drawn_with_the_probability_reported() {
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut edges = Vec::new();
+        let mut facts = Vec::new();
+        let mut weights = Vec::new();
+        for _ in 0..200 {
+            let a = DVec3::new(next() * 4.0 - 2.0, next() * 4.0 - 2.0, next() * 2.0);
+            let b = a + DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 0.6;
+            edges.push(Edge {
+                a,
+                b,
+                faces: [0, NO_PRIM],
+                shape: 0,
+            });
+            facts.push(EdgeFacts {
+                normals: [DVec3::Z; 2],
+                always: true,
+            });
+            weights.push((b - a).length());
+        }
+        let tree = EdgeTree::new(&edges, &facts, &weights, (0..200).collect());
+        for x in [DVec3::new(0.1, -0.2, -1.0), DVec3::new(0.3, 0.2, 1.0)] {
+            let n = 400_000;
+            let mut drawn: Vec<(u32, f64)> = vec![(0, 0.0); 200];
+            for k in 0..n {
+                let u = (k as f64 + 0.5) / n as f64;
+                let (e, p, rest) = tree.sample(x, u, &edges, &facts, &weights).unwrap();
+                assert!((0.0..1.0).contains(&rest));
+                let slot = &mut drawn[e as usize];
+                if slot.0 > 0 {
+                    assert_eq!(slot.1, p, "edge {e}: one probability per edge");
+                }
+                *slot = (slot.0 + 1, p);
+            }
+            let total: f64 = drawn.iter().map(|d| d.1).sum();
+            assert!((total - 1.0).abs() < 1e-12, "Σ p = {total}");
+            for (e, &(count, p)) in drawn.iter().enumerate() {
+                // The grid of u is stratified: an edge's count is its
+                // share of [0, 1) to within the strata its ends cut, a few
+                // per level of the tree.
+                let share = count as f64 / n as f64;
+                assert!(
+                    (share - p).abs() < 40.0 / n as f64,
+                    "edge {e}: {share} against {p}"
+                );
+            }
+            // Nearer edges are drawn more often than far ones, per unit
+            // weight: the distance enters.
+            let mut by_distance: Vec<(f64, f64)> = edges
+                .iter()
+                .zip(&drawn)
+                .zip(&weights)
+                .map(|((e, &(_, p)), w)| ((0.5 * (e.a + e.b) - x).length(), p / w))
+                .collect();
+            by_distance.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mean = |q: &[(f64, f64)]| q.iter().map(|v| v.1).sum::<f64>() / q.len() as f64;
+            let (close, far) = (mean(&by_distance[..50]), mean(&by_distance[150..]));
+            assert!(close > 2.0 * far, "near {close}, far {far}");
         }
     }
 }
