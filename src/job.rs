@@ -7,8 +7,7 @@
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::method::{Method, Problem};
-use crate::report::{Header, Report, rod_exact, rod_quantities};
-use crate::rod::{Direction, Probe, Rod};
+use crate::report::{Header, Report, RodProbe, rod_exact, rod_quantities};
 use crate::runner::{RunConfig, RunResult, run};
 use crate::stats::Estimate;
 use crate::{flat, mesh};
@@ -113,19 +112,8 @@ impl SceneSource {
 /// What a job estimates on.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Target {
-    /// A probe on a rod: κs, κe, length, position and direction (±1).
-    Rod {
-        /// Scattering coefficient κs.
-        ks: f64,
-        /// Extinction coefficient κe.
-        ke: f64,
-        /// Length π̃.
-        length: f64,
-        /// Probe position.
-        x: f64,
-        /// Probe direction, ±1.
-        omega: f64,
-    },
+    /// A probe on a rod.
+    Rod(RodProbe),
     /// A flatland scene (`geosens flat`).
     Flat(SceneSource),
     /// A 3D scene (`geosens mesh`).
@@ -222,36 +210,18 @@ impl Job {
             )));
         }
         match &self.target {
-            &Target::Rod {
-                ks,
-                ke,
-                length,
-                x,
-                omega,
-            } => {
-                let rod = Rod::new(ks, ke, length)?;
-                let probe = Probe::new(&rod, x, Direction::from_sign(omega)?)?;
+            Target::Rod(given) => {
+                let (rod, probe) = given.build()?;
                 let estimator = match method {
                     Some(m) => Some(estimator_of(m, (rod, probe), self.fd_step, None)?),
                     None => None,
                 };
+                let r = RodProbe::of(&rod, &probe);
                 Ok(Prepared {
                     caveats: estimator.as_ref().map_or(Vec::new(), |e| e.caveats()),
                     estimator,
-                    header: Header::Rod {
-                        ks: rod.ks,
-                        ke: rod.ke,
-                        length: rod.length,
-                        x: probe.x,
-                        omega: probe.omega.sign(),
-                    },
-                    canonical: Canonical::Rod([
-                        rod.ks,
-                        rod.ke,
-                        rod.length,
-                        probe.x,
-                        probe.omega.sign(),
-                    ]),
+                    header: Header::Rod(r),
+                    canonical: Canonical::Rod([r.ks, r.ke, r.length, r.x, r.omega]),
                 })
             }
             Target::Flat(source) | Target::Mesh(source) => {
@@ -334,18 +304,10 @@ fn estimator_of(
 /// The rod's exact solution as a [`RunResult`] (stderr 0, `paths` 0:
 /// nothing is sampled; `seconds` is the time of the evaluation).
 pub fn exact_result(header: &Header) -> Result<RunResult, Error> {
-    let &Header::Rod {
-        ks,
-        ke,
-        length,
-        x,
-        omega,
-    } = header
-    else {
+    let Header::Rod(given) = header else {
         return Err(Error::Config("the exact solution is the rod's only".into()));
     };
-    let rod = Rod::new(ks, ke, length)?;
-    let probe = Probe::new(&rod, x, Direction::from_sign(omega)?)?;
+    let (rod, probe) = given.build()?;
     let start = Instant::now();
     let values = rod_exact(&rod, &probe);
     let seconds = start.elapsed().as_secs_f64();

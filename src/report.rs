@@ -16,23 +16,48 @@ use crate::stats::Estimate;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;
 
+/// A probe on a rod as a user gives it (unchecked): what `geosens rod`
+/// takes and its table's first line says.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RodProbe {
+    /// Scattering coefficient κs.
+    pub ks: f64,
+    /// Extinction coefficient κe.
+    pub ke: f64,
+    /// Length π̃.
+    pub length: f64,
+    /// Probe position.
+    pub x: f64,
+    /// Probe direction, ±1.
+    pub omega: f64,
+}
+
+impl RodProbe {
+    /// The rod and probe, validated (errors name the bad value).
+    pub fn build(&self) -> Result<(Rod, Probe), Error> {
+        let rod = Rod::new(self.ks, self.ke, self.length)?;
+        let probe = Probe::new(&rod, self.x, Direction::from_sign(self.omega)?)?;
+        Ok((rod, probe))
+    }
+
+    /// The user-facing form of a validated rod and probe.
+    pub fn of(rod: &Rod, probe: &Probe) -> RodProbe {
+        RodProbe {
+            ks: rod.ks,
+            ke: rod.ke,
+            length: rod.length,
+            x: probe.x,
+            omega: probe.omega.sign(),
+        }
+    }
+}
+
 /// What was estimated on, as the table's first line says it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Header {
     /// A probe on a rod.
-    Rod {
-        /// Scattering coefficient κs.
-        ks: f64,
-        /// Extinction coefficient κe.
-        ke: f64,
-        /// Length π̃.
-        length: f64,
-        /// Probe position.
-        x: f64,
-        /// Probe direction, ±1.
-        omega: f64,
-    },
+    Rod(RodProbe),
     /// A flatland or 3D scene.
     Scene {
         /// The scene as the table names it (its file, or `<dict>`).
@@ -48,19 +73,10 @@ impl Header {
     /// The rod and probe of a rod header (validated again: a header read
     /// from a state file is user data).
     fn rod(&self) -> Result<Option<(Rod, Probe)>, Error> {
-        let Header::Rod {
-            ks,
-            ke,
-            length,
-            x,
-            omega,
-        } = *self
-        else {
-            return Ok(None);
-        };
-        let rod = Rod::new(ks, ke, length)?;
-        let probe = Probe::new(&rod, x, Direction::from_sign(omega)?)?;
-        Ok(Some((rod, probe)))
+        match self {
+            Header::Rod(r) => r.build().map(Some),
+            Header::Scene { .. } => Ok(None),
+        }
     }
 }
 
@@ -202,7 +218,7 @@ impl Report {
         self.check_finite()?;
         let r = &self.result;
         let mean_err = |q: &Quantity, e: &Estimate| MeanErr::of(e, caveat_of(&self.caveats, q));
-        if matches!(self.header, Header::Rod { .. }) {
+        if matches!(self.header, Header::Rod(_)) {
             let [i, s, g] = rod_quantities().map(|q| r.get(&q).map(|e| mean_err(&q, &e)));
             return to_json(&RodJsonLine {
                 method: r.method,
@@ -245,7 +261,7 @@ impl Report {
     pub fn table(&self) -> Result<String, Error> {
         self.check_finite()?;
         match &self.header {
-            Header::Rod { .. } => self.rod_table(),
+            Header::Rod(_) => self.rod_table(),
             Header::Scene {
                 scene,
                 shapes,

@@ -129,13 +129,13 @@ fn rod(
     // them.
     let method = geosens::job::parse_method(method, true).map_err(value_error)?;
     let job = Job {
-        target: Target::Rod {
+        target: Target::Rod(geosens::report::RodProbe {
             ks,
             ke,
             length,
             x,
             omega,
-        },
+        }),
         method,
         fd_step,
     };

@@ -1,7 +1,7 @@
 //! The subcommands: `rod`, `compare` and `flat`, each printing a table or
 //! one JSON line.
 use super::*;
-use geosens::report::{yes_no, z_text};
+use geosens::report::{RodProbe, yes_no, z_text};
 use geosens::shard::Merged;
 
 /// `geosens rod`.
@@ -10,13 +10,13 @@ pub(super) fn rod_command(
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let job = Job {
-        target: Target::Rod {
+        target: Target::Rod(RodProbe {
             ks: args.ks,
             ke: args.ke,
             length: args.length,
             x: args.x,
             omega: args.omega,
-        },
+        }),
         method: args.method.0,
         fd_step: args.fd.fd_step,
     };

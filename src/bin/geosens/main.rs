@@ -260,21 +260,10 @@ fn slot(q: &Quantity) -> usize {
     }
 }
 
-/// The header of a rod probe.
-fn rod_header(rod: &Rod, probe: &Probe) -> Header {
-    Header::Rod {
-        ks: rod.ks,
-        ke: rod.ke,
-        length: rod.length,
-        x: probe.x,
-        omega: probe.omega.sign(),
-    }
-}
-
 /// The exact solution as a [`RunResult`] (stderr 0, `paths` 0: nothing is
 /// sampled; `seconds` is the time of the evaluation).
 fn exact_result(rod: &Rod, probe: &Probe) -> Result<RunResult, Error> {
-    geosens::job::exact_result(&rod_header(rod, probe))
+    geosens::job::exact_result(&Header::Rod(geosens::report::RodProbe::of(rod, probe)))
 }
 
 mod commands;
