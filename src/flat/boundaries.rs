@@ -81,8 +81,8 @@ impl Boundaries for Plane {
 
     // ANCHOR: sides
     /// The segments at the corner that lie on either side of the sight line
-    /// `ω` from `x`; on each side the ray just past the line meets the one
-    /// whose direction `d` from the corner has the least `(d·ω)/|ω × d|`
+    /// `η` from `x`; on each side the ray just past the line meets the one
+    /// whose direction `d` from the corner has the least `(d·η)/|η × d|`
     /// (it is crossed first), or none.
     fn sides(&self, x: DVec2, b: &BoundaryPoint<DVec2>) -> (Side, Side) {
         let w = (b.q - x).normalize();

@@ -4,8 +4,8 @@
 //! **Occluders** ([`OccludedIrradiance`]). A sensor at `p` with unit normal
 //! `n` (angle `θn`) sees a two-sided Lambertian emitter segment `[a, b]` of
 //! radiance `Le` through opaque black occluders (polygons, polylines). With
-//! `ω(θ) = (cos θ, sin θ)`, the irradiance
-//! `E = ∫_{ω·n>0} Le·V(θ)·cos(θ − θn) dθ`, where `V(θ) = 1` when the sight
+//! `η(θ) = (cos θ, sin θ)`, the irradiance
+//! `E = ∫_{η·n>0} Le·V(θ)·cos(θ − θn) dθ`, where `V(θ) = 1` when the sight
 //! line reaches the emitter unblocked, is a sum over the visible angular
 //! intervals `[α, β]`:
 //!
@@ -31,7 +31,7 @@
 //! self-intersections), to a relative error well below 1e-8. With
 //! `c = Σ ±t_i` over the boundary crossings `t_i` (`+` leaving, `−` entering;
 //! plus the emitter's distance `t_e` when it lies inside), each crossing of a
-//! moving edge with unit normal `m` moves by `ṫ = (q̇·m)/(ω·m)`, and
+//! moving edge with unit normal `m` moves by `ṫ = (q̇·m)/(η·m)`, and
 //!
 //! `dE/dπ = Le Σ [cos(β − θn) T(β) β̇ − cos(α − θn) T(α) α̇]
 //!        − κe Le Σ ∫_α^β cos(θ − θn) T ċ dθ`.
@@ -566,7 +566,7 @@ impl AbsorbedIrradiance {
         let (p, w) = (self.view.point, self.view.direction(phi));
         let (a, b) = (self.view.emitter.a, self.view.emitter.b);
         let t_end = self.view.distance(w, a, b);
-        // Rate of a crossing at fraction s of edge [u, v] of `id`: ṫ = (q̇·m)/(ω·m).
+        // Rate of a crossing at fraction s of edge [u, v] of `id`: ṫ = (q̇·m)/(η·m).
         let rate = |id, u: DVec2, v: DVec2, s: f64| {
             velocity.map_or(0.0, |vel| {
                 cross(v - u, vel(id, u).lerp(vel(id, v), s)) / cross(v - u, w)

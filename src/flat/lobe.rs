@@ -1,5 +1,5 @@
 //! Flatland's directional integrands: the 2D cosine lobe (density
-//! `(ω·n)⁺/2` over the half circle) and the phase functions (isotropic
+//! `(η·n)⁺/2` over the half circle) and the phase functions (isotropic
 //! `1/2π`, and the 2D Henyey–Greenstein function, the wrapped Cauchy law,
 //! sampled by its inverse CDF), with the derivative of their logarithm along
 //! a moving direction. Book: chapter "Flatland", section "Backward path
@@ -15,8 +15,8 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 /// The directional integrands of flatland.
 #[derive(Debug, Clone, Copy)]
 pub enum FlatLobe {
-    /// `c (ω·n)⁺`: the sensor (`c = 1`) or a Lambertian reflector
-    /// (`c = ρ/2`), sampled with density `(ω·n)⁺/2`.
+    /// `c (η·n)⁺`: the sensor (`c = 1`) or a Lambertian reflector
+    /// (`c = ρ/2`), sampled with density `(η·n)⁺/2`.
     Cosine {
         /// Unit normal.
         n: DVec2,
@@ -30,7 +30,7 @@ pub enum FlatLobe {
         /// Incoming direction.
         w_in: DVec2,
     },
-    /// A line camera's pixel stratum: `p(ω) = |ξ|² / (x1 − x0)` for the
+    /// A line camera's pixel stratum: `p(η) = |ξ|² / (x1 − x0)` for the
     /// directions through `ξ = f + x r`, `x ∈ [x0, x1]` on the image line at
     /// unit distance (`dθ = dx / |ξ|²`), 0 elsewhere; value = density.
     Pixel {
@@ -142,7 +142,7 @@ impl Lobe<DVec2> for FlatLobe {
         match *self {
             FlatLobe::Cosine { n, .. } => wd.dot(n) / w.dot(n),
             FlatLobe::Phase { phase, w_in } => phase_dlog_dcos(phase, w.dot(w_in)) * wd.dot(w_in),
-            // ln p = −2 ln(ω·f) + const inside the footprint.
+            // ln p = −2 ln(η·f) + const inside the footprint.
             FlatLobe::Pixel { f, .. } => -2.0 * wd.dot(f) / w.dot(f),
         }
     }

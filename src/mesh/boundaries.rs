@@ -101,7 +101,7 @@ impl Space {
     /// camera pixel `pixel` from the pinhole `x`: uniform in image-plane
     /// length, `inv_pdf` per unit arc length on the sphere (the image
     /// plane's length `L` over the pieces, times the arc's rate
-    /// `|T − ω(ω·T)| / |ξ|` per unit image length along the piece's
+    /// `|T − η(η·T)| / |ξ|` per unit image length along the piece's
     /// direction `T`).
     fn pixel_boundary(
         &self,
@@ -224,11 +224,11 @@ impl Boundaries for Space {
     // ANCHOR_END: sample_boundary
 
     // ANCHOR: sides
-    /// The faces at the edge on either side of the sight line `ω` from `x`:
+    /// The faces at the edge on either side of the sight line `η` from `x`:
     /// face `i` lies on the side its inward direction `d_i` (in its plane,
     /// perpendicular to the edge) points to across the line, `sign(d_i·n)`
     /// for the arc's normal `n`; on each side the ray just past the line
-    /// meets the face with the least `(d_i·ω)/|d_i·n|` first, or none.
+    /// meets the face with the least `(d_i·η)/|d_i·n|` first, or none.
     fn sides(&self, x: DVec3, b: &BoundaryPoint<DVec3>) -> (Side, Side) {
         let w = (b.q - x).normalize();
         let n = self.boundary_normal(x, b);
@@ -253,7 +253,7 @@ impl Boundaries for Space {
     }
     // ANCHOR_END: sides
 
-    /// `ω × ê / |ω × ê|`: normal to the edge's arc on the sphere at `ω`.
+    /// `η × ê / |η × ê|`: normal to the edge's arc on the sphere at `η`.
     #[inline]
     fn boundary_normal(&self, x: DVec3, b: &BoundaryPoint<DVec3>) -> DVec3 {
         let edge = &self.edge_tables().edges[b.index as usize];

@@ -1,10 +1,10 @@
 //! The pinhole camera of 3D scenes: each pixel's reading is its mean
 //! radiance over its footprint on the image plane (a box filter),
 //!
-//! `P = (1/A) ∫_pixel L(e, ω(ξ)) dξ = ∫ L(e, ω) p(ω) dω`,  `p(ω) = |ξ|³ / A`
+//! `P = (1/A) ∫_pixel L(e, η(ξ)) dξ = ∫ L(e, η) p(η) dη`,  `p(η) = |ξ|³ / A`
 //!
 //! where `ξ = f + x r + y u` is the image-plane point at unit distance along
-//! the view axis `f` (`dω = dξ / |ξ|³`), `A` the footprint's area. `p` is the
+//! the view axis `f` (`dη = dξ / |ξ|³`), `A` the footprint's area. `p` is the
 //! lobe of the camera vertex ([`SpaceLobe::Pixel`](super::lobe::SpaceLobe::Pixel)), so the path core treats
 //! a pixel like any other directional integral:
 //!

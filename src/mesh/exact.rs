@@ -11,7 +11,7 @@
 //! `E = (L/2) |Σ_i β_i (n·γ̂_i)|`,
 //!
 //! the absolute value fixing the winding as seen from `x` (the emitter is
-//! two-sided). The sensor integrates `(ω·n)⁺` only, so the polygon is first
+//! two-sided). The sensor integrates `(η·n)⁺` only, so the polygon is first
 //! clipped to the half-space `n·(p − x) ≥ 0` (Sutherland–Hodgman).
 //!
 //! **Occluders.** A convex black occluder lying strictly between `x` and the

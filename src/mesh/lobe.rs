@@ -1,5 +1,5 @@
 //! The directional integrands of 3D scenes: the cosine lobe (the irradiance
-//! sensor, a Lambertian reflector), sampled with density `(ω·n)⁺/π`, and the
+//! sensor, a Lambertian reflector), sampled with density `(η·n)⁺/π`, and the
 //! Henyey–Greenstein phase function, sampled exactly, each with the
 //! derivative of its logarithm along a moving direction. Book: chapter
 //! "Three dimensions", section "Lobes".
@@ -12,8 +12,8 @@ use std::f64::consts::{FRAC_1_PI, PI};
 /// A directional integrand in space.
 #[derive(Debug, Clone, Copy)]
 pub enum SpaceLobe {
-    /// `c (ω·n)⁺`: the sensor (`c = 1`) or a Lambertian reflector
-    /// (`c = ρ/π`), sampled with density `(ω·n)⁺/π`.
+    /// `c (η·n)⁺`: the sensor (`c = 1`) or a Lambertian reflector
+    /// (`c = ρ/π`), sampled with density `(η·n)⁺/π`.
     Cosine {
         /// Unit normal.
         n: DVec3,
@@ -21,14 +21,14 @@ pub enum SpaceLobe {
         c: f64,
     },
     /// The Henyey–Greenstein phase function about the incoming `w_in`:
-    /// `p(μ) = (1 − g²) / (4π (1 + g² − 2gμ)^{3/2})`, `μ = ω·w_in`.
+    /// `p(μ) = (1 − g²) / (4π (1 + g² − 2gμ)^{3/2})`, `μ = η·w_in`.
     Phase {
         /// Mean cosine.
         g: f64,
         /// Incoming direction (unit).
         w_in: DVec3,
     },
-    /// A camera pixel's stratum: `p(ω) = |ξ|³ / A` for the directions
+    /// A camera pixel's stratum: `p(η) = |ξ|³ / A` for the directions
     /// through the image-plane rectangle `rect` (`ξ = f + x r + y u`, `A`
     /// its area), 0 elsewhere; value and density alike (weight 1). See
     /// [`super::camera`].
@@ -127,7 +127,7 @@ impl Lobe<DVec3> for SpaceLobe {
             SpaceLobe::Phase { g, w_in } => {
                 3.0 * g * wd.dot(w_in) / (1.0 + g * g - 2.0 * g * w.dot(w_in))
             }
-            // ln p = −3 ln(ω·f) + const inside the footprint.
+            // ln p = −3 ln(η·f) + const inside the footprint.
             SpaceLobe::Pixel { frame, .. } => -3.0 * wd.dot(frame[0]) / w.dot(frame[0]),
         }
     }
@@ -139,12 +139,12 @@ mod tests {
     use crate::rng::stream;
 
     /// The lobes' samples have the density they report: the mean of
-    /// `h(ω)/pdf(ω)` over draws is `∫ h dω` for a test function `h`.
+    /// `h(η)/pdf(η)` over draws is `∫ h dη` for a test function `h`.
     #[test]
     fn samples_follow_the_density() {
         let mut rng = stream(3, 0);
         let n = DVec3::new(0.3, -0.4, 0.8).normalize();
-        // ∫ (ω·a)² dω over the sphere = 4π/3; over the hemisphere 2π/3.
+        // ∫ (η·a)² dη over the sphere = 4π/3; over the hemisphere 2π/3.
         let a = DVec3::new(1.0, 2.0, -0.5).normalize();
         for (lobe, exact) in [
             (SpaceLobe::Cosine { n, c: 1.0 }, None),
@@ -163,8 +163,8 @@ mod tests {
             }
             let mean = s / m as f64;
             let se = ((s2 / m as f64 - mean * mean) / m as f64).sqrt();
-            // The hemisphere about n: ∫ (ω·a)² = (2π/3)(…) by symmetry of
-            // the quadratic form: ∫_{H} ω_i ω_j dω = (2π/3) δ_ij.
+            // The hemisphere about n: ∫ (η·a)² = (2π/3)(…) by symmetry of
+            // the quadratic form: ∫_{H} η_i η_j dη = (2π/3) δ_ij.
             let exact = exact.unwrap_or(2.0 * PI / 3.0);
             assert!(
                 (mean - exact).abs() < 4.0 * se,

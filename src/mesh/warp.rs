@@ -2,14 +2,14 @@
 //! flatland warps along half great circles ("fibres") from a pole `p` to
 //! `−p`.
 //!
-//! The field is `V(ω) = Ω × ω + α(ω) e_θ(ω)`: the frame's rotation `Ω`
+//! The field is `V(η) = Ω × η + α(η) e_θ(η)`: the frame's rotation `Ω`
 //! plus a component along the fibre (`e_θ`, the direction of growing polar
 //! angle θ from `p`). Along each fibre, `α` is piecewise linear in θ between
 //! *knots*: the poles and the lobe's horizon (where `α = 0`: they move with
 //! the frame) and the points where the fibre's plane (through the vertex
-//! `x`, `p` and `ω`) cuts a visible edge of an opaque mesh, with `α` the
+//! `x`, `p` and `η`) cuts a visible edge of an opaque mesh, with `α` the
 //! rate at which that crossing slides along the fibre when the edge moves
-//! relative to the frame. Only the knots nearest to ω on either side are
+//! relative to the frame. Only the knots nearest to η on either side are
 //! needed, found by a scan of the edges and a shadow ray per candidate.
 //!
 //! Why this is a valid warp: the domain-deformation identity
@@ -122,7 +122,7 @@ pub struct SpaceWarp {
 pub struct FibreField {
     /// The fibre's plane's unit normal `p × u`.
     m: DVec3,
-    /// Cosine and sine of ω's polar angle, and `e_θ` there.
+    /// Cosine and sine of η's polar angle, and `e_θ` there.
     cos: f64,
     sin: f64,
     e_w: DVec3,
@@ -212,7 +212,7 @@ impl Space {
         let s = perp.length();
         let still = |cos: f64| FibreKnot { cos, edge: None };
         if s < 1e-12 {
-            // ω at a pole: the field is the frame's there.
+            // η at a pole: the field is the frame's there.
             return FibreField {
                 m: DVec3::ZERO,
                 cos: c,

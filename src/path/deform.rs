@@ -1,14 +1,14 @@
 //! The deformation a derivative walk carries along its path: per derivative
 //! slot `j` (a shape parameter, or an axis of the sensor's position), the
-//! velocity `u_j = ∂x/∂π_j` of the current vertex, the velocity `ω̇_j` of the
+//! velocity `u_j = ∂x/∂π_j` of the current vertex, the velocity `η̇_j` of the
 //! current direction (a vector tangent to the circle or sphere), the running
 //! score `Λ_j` (the derivative of the log weight along the deformation) and
 //! the boundary terms collected so far.
 //!
-//! The one formula every method uses: a ray from `x` along `ω` meets a
+//! The one formula every method uses: a ray from `x` along `η` meets a
 //! boundary moving at `v` at distance `t_b`; the hit point stays on it,
-//! `(u + ṫ_b ω + t_b ω̇ − v)·n = 0`, so
-//! `ṫ_b = (v − u − t_b ω̇)·n / (ω·n)` (book: "Flatland: one deformation,
+//! `(u + ṫ_b η + t_b η̇ − v)·n = 0`, so
+//! `ṫ_b = (v − u − t_b η̇)·n / (η·n)` (book: "Flatland: one deformation,
 //! three estimators", *the hit point's velocity*), in the plane and in space.
 use super::rendering::Rendering;
 use super::walk::{Vertex, light_sample, transmittance};
@@ -95,7 +95,7 @@ impl SlotSet {
 pub struct Slot<V: Vector> {
     /// Vertex velocity `u_j`.
     pub u: V,
-    /// Direction velocity `ω̇_j`.
+    /// Direction velocity `η̇_j`.
     pub wd: V,
     /// Running score `Λ_j`.
     pub score: f64,
@@ -152,7 +152,7 @@ impl<V: Vector> Slot<V> {
 }
 
 /// The deformation state of one walk: every slot, and the set of slots whose
-/// `u`, `ω̇` or score may be non-zero (the others are skipped: their updates
+/// `u`, `η̇` or score may be non-zero (the others are skipped: their updates
 /// would add exact zeros).
 #[derive(Debug, Clone)]
 pub struct Deform<V: Vector> {
@@ -284,7 +284,7 @@ impl<V: Vector> Deform<V> {
     }
 
     /// A fixed free path `ξ`: every live slot's vertex moves with its
-    /// turning direction only, `u += ξ ω̇`.
+    /// turning direction only, `u += ξ η̇`.
     #[inline]
     pub fn carry(&mut self, xi: f64) {
         for j in self.live.iter() {
@@ -294,7 +294,7 @@ impl<V: Vector> Deform<V> {
     }
 
     /// Moves the vertex of every slot in `rule` onto the boundary at
-    /// distance `t` along `w`: `u += ṫ_b ω + t ω̇`.
+    /// distance `t` along `w`: `u += ṫ_b η + t η̇`.
     #[inline]
     pub fn arrive(&mut self, rule: SlotSet, w: V, t: f64) {
         for j in self.live.and(rule).iter() {
@@ -436,7 +436,7 @@ impl<V: Vector> Scratch<V> {
 // ANCHOR: connect
 /// Next-event estimation at `v` for a derivative walk in state `d`: one
 /// emitter point drawn as the intensity estimator draws it; its direction
-/// `ω` deforms as `direction` sets it (the method's rule: the frame's turn,
+/// `η` deforms as `direction` sets it (the method's rule: the frame's turn,
 /// the warp), the connection's segments follow, and `contribution × score`
 /// is added to every slot. The connection's segments are followed by
 /// rendering's hooks (it has no free path, so only their boundary speed,

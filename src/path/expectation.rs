@@ -32,7 +32,7 @@ pub struct Expectation<'a, G: Geometry> {
 }
 
 // ANCHOR: warp
-/// Moves the direction `w` drawn at `v` with the warp: every slot's `ω̇`,
+/// Moves the direction `w` drawn at `v` with the warp: every slot's `η̇`,
 /// and the warp's divergence plus `∂ ln f` along it added to its score.
 #[inline]
 fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>, w: G::V) {

@@ -84,8 +84,8 @@ pub trait Vector:
     const STILL: Self::Spin;
     /// Number of coordinates.
     const DIM: usize;
-    /// `1 / ∫ (ω·n)⁺ dω` over the directions: a Lambertian reflector of
-    /// albedo ρ has the lobe `ρ · LAMBERT · (ω·n)⁺` (1/2 in the plane, 1/π
+    /// `1 / ∫ (η·n)⁺ dη` over the directions: a Lambertian reflector of
+    /// albedo ρ has the lobe `ρ · LAMBERT · (η·n)⁺` (1/2 in the plane, 1/π
     /// in space).
     const LAMBERT: f64;
     /// The unit vector along coordinate axis `i`.
@@ -168,7 +168,7 @@ pub enum Sensor<V> {
         /// Looking direction (unit).
         direction: V,
     },
-    /// The irradiance `∫ L (ω·n)⁺ dω` at `point` with unit normal `normal`.
+    /// The irradiance `∫ L (η·n)⁺ dη` at `point` with unit normal `normal`.
     Irradiance {
         /// Where.
         point: V,
@@ -218,7 +218,7 @@ pub struct Hit {
 /// radiance: a cosine lobe (the irradiance sensor, a Lambertian reflector)
 /// or a phase function, with the density that samples it.
 pub trait Lobe<V: Vector>: Copy {
-    /// The integrand's factor `f(ω)`.
+    /// The integrand's factor `f(η)`.
     fn value(&self, w: V) -> f64;
     /// The density with which [`Lobe::sample`] draws `w`.
     fn pdf(&self, w: V) -> f64;
@@ -226,7 +226,7 @@ pub trait Lobe<V: Vector>: Copy {
     fn weight(&self) -> f64;
     /// A direction drawn with density [`Lobe::pdf`].
     fn sample(&self, rng: &mut PathRng) -> V;
-    /// The derivative of `ln f(ω)` when `ω` moves at `wd` relative to the
+    /// The derivative of `ln f(η)` when `η` moves at `wd` relative to the
     /// lobe's frame.
     fn dlog(&self, w: V, wd: V) -> f64;
 }
@@ -244,7 +244,7 @@ pub trait Geometry: Sync {
     /// What the sensor measures, and where.
     fn sensor(&self) -> Sensor<Self::V>;
     /// For a camera: the lobe over directions of the footprint of `s`'s
-    /// stratum, `p(ω)` uniform over that part of the image plane (as a
+    /// stratum, `p(η)` uniform over that part of the image plane (as a
     /// density over directions), value = density, so a path's reading is
     /// the stratum's mean radiance. `None` where the geometry has no camera.
     fn pixel_lobe(&self, s: PixelSample) -> Option<Self::Lobe> {
@@ -274,7 +274,7 @@ pub trait Geometry: Sync {
     /// The medium entered or left when a ray in `m` crosses the transparent
     /// boundary of shape `k`.
     fn crossed(&self, m: MediumId, k: u32) -> MediumId;
-    /// The cosine lobe `c (ω·n)⁺` about the unit normal `n`.
+    /// The cosine lobe `c (η·n)⁺` about the unit normal `n`.
     fn cosine_lobe(&self, n: Self::V, c: f64) -> Self::Lobe;
     /// The phase function of medium `m` about the incoming direction `w`.
     fn phase_lobe(&self, m: MediumId, w: Self::V) -> Self::Lobe;
@@ -340,7 +340,7 @@ pub trait Boundaries: Geometry {
     /// [`Boundaries::boundary_normal`] points to (plane: counter-clockwise),
     /// then the other.
     fn sides(&self, x: Self::V, b: &BoundaryPoint<Self::V>) -> (Side, Side);
-    /// The unit vector tangent to the directions at `ω_q` (the direction
+    /// The unit vector tangent to the directions at `η_q` (the direction
     /// from `x` to the boundary point), normal to the boundary there and
     /// pointing to the side [`Boundaries::sides`] names first.
     fn boundary_normal(&self, x: Self::V, b: &BoundaryPoint<Self::V>) -> Self::V;

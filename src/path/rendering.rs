@@ -7,7 +7,7 @@
 //! - the **Leibniz term** of a free-path domain `[0, t_b]` whose end moves:
 //!   `κs e^{−κe t_b} L_s(t_b⁻) ṫ_b`, `L_s` from one nested path;
 //! - the **jump** across a discontinuity of the directional integrand (a
-//!   corner seen from the vertex): `f(ω_q) T(x, q) [L_behind(q) − L_ahead(q)]
+//!   corner seen from the vertex): `f(η_q) T(x, q) [L_behind(q) − L_ahead(q)]
 //!   v_n`, `v_n` the discontinuity's velocity relative to the frame, one
 //!   discontinuity drawn at random and each side's radiance from one nested
 //!   path evaluated exactly at it (double randomisation);
@@ -83,7 +83,7 @@ pub(super) fn frame_spins<G: Geometry>(
     turning
 }
 
-/// Directions attached to the frame: `ω̇ = Ω × ω` for the slots in `rule`.
+/// Directions attached to the frame: `η̇ = Ω × η` for the slots in `rule`.
 #[inline]
 pub(super) fn attach<V: Vector>(d: &mut Deform<V>, rule: SlotSet, turning: SlotSet, w: V) {
     for j in d.live.union(turning).and(rule).iter() {
@@ -199,7 +199,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     let mut twin = rng.clone();
     let l_ahead = side(rng, ahead);
     let l_behind = side(&mut twin, behind);
-    // d/dπ ∫ f L dω ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
+    // d/dπ ∫ f L dη ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
     let term = v.beta * f * t * (l_behind - l_ahead) * b.inv_pdf;
     for j in involved.iter() {
         let s = &mut d.slots[j];

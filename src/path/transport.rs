@@ -3,7 +3,7 @@
 //! space (Eulerian) and collects `s`'s sources where it meets a moving
 //! boundary:
 //!
-//! - at an **opaque** moving boundary hit at `y`: `−v·∇L(y⁻, ω)`, the
+//! - at an **opaque** moving boundary hit at `y`: `−v·∇L(y⁻, η)`, the
 //!   gradient by a nested walk in the frozen scene started just before `y`
 //!   with velocity `v` ([`Rendering`] with `frozen`);
 //! - at a moving **reflector**: the material derivative of the reflected

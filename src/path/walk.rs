@@ -64,8 +64,8 @@ pub struct Vertex<G: Geometry> {
     pub frame: Frame,
     /// The direction the path arrived along.
     pub w_in: G::V,
-    /// Throughput, the lobe's weight included: a term `f(ω) X(ω)/p(ω)`
-    /// estimated at the vertex counts `beta · pdf(ω)/p(ω) · X(ω)`.
+    /// Throughput, the lobe's weight included: a term `f(η) X(η)/p(η)`
+    /// estimated at the vertex counts `beta · pdf(η)/p(η) · X(η)`.
     pub beta: f64,
     /// Whether this is the irradiance sensor (whose warp knots are known).
     pub at_sensor: bool,
@@ -175,7 +175,7 @@ pub fn reflector_lobe<G: Geometry>(g: &G, p: Prim, y: G::V, w: G::V, albedo: f64
 
 /// The emitter point drawn for next-event estimation at `v`: the direction
 /// to it, its primitive, the light strategy's density there, and the
-/// connection's weight before transmittance `beta pdf(ω) Le / p_light ·
+/// connection's weight before transmittance `beta pdf(η) Le / p_light ·
 /// w_MIS` (0 if the lobe or the emitter turns away).
 #[inline]
 pub fn light_sample<G: Geometry>(

@@ -5,7 +5,7 @@
 //! corners the sensor sees (where it equals the corner's own angular
 //! velocity, so that no visibility edge moves relative to the directions)
 //! and at the horizons (where it is pinned to the sensor's frame). The
-//! scene panels draw it as arrows `t V_j(φ) ω⊥` at the ends of a fan of
+//! scene panels draw it as arrows `t V_j(φ) η⊥` at the ends of a fan of
 //! rays, `t` the ray's length: how the ray's end point moves.
 use super::scene::{ViewBox, sensor, shapes, surface_legend};
 use super::{FigureOptions, REFERENCE_COLOR, load, parameter, save};
@@ -158,7 +158,7 @@ fn arrow(a: DVec2, b: DVec2, head: f64) -> Vec<(f64, f64)> {
 
 /// The scene with a fan of rays from the sensor and, at the end of each ray
 /// that hits a shape (rays that hit nothing have no end to move), the arrow
-/// `t V_j(φ) ω⊥` of parameter `j` (colour `color`), scaled so the longest is
+/// `t V_j(φ) η⊥` of parameter `j` (colour `color`), scaled so the longest is
 /// a tenth of the scene.
 fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel {
     let scene: &Scene = plane.scene();

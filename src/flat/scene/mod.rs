@@ -180,7 +180,7 @@ pub enum Sensor {
         #[serde(deserialize_with = "repr::direction")]
         direction: DVec2,
     },
-    /// Irradiance `E = ∫ L(ω) (ω·n)⁺ dθ` at `point` with unit normal `n`.
+    /// Irradiance `E = ∫ L(η) (η·n)⁺ dθ` at `point` with unit normal `n`.
     Irradiance {
         /// Where.
         #[serde(deserialize_with = "repr::point")]

@@ -167,7 +167,7 @@ pub enum Sensor {
         /// Looking direction.
         direction: DVec3,
     },
-    /// Irradiance `E = ∫ L(ω) (ω·n)⁺ dω` at `point` with unit normal `n`.
+    /// Irradiance `E = ∫ L(η) (η·n)⁺ dη` at `point` with unit normal `n`.
     Irradiance {
         /// Where.
         point: DVec3,
