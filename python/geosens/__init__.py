@@ -73,10 +73,26 @@ def _fd_step(fd_step: Optional[float]) -> Optional[float]:
     return None if fd_step is None else float(fd_step)
 
 
+def _plain(value: Any) -> Any:
+    """numpy arrays and scalars, a sweep's usual values, as the lists and
+    numbers JSON has."""
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not a scene value")
+
+
 def _scene(scene: Scene) -> Tuple[Optional[str], Optional[str]]:
     """The scene as (file, None) or (None, JSON text)."""
     if isinstance(scene, dict):
-        return None, json.dumps(scene)
+        try:
+            return None, json.dumps(scene, default=_plain, allow_nan=False)
+        except ValueError as e:
+            # json's "Out of range float values are not JSON compliant".
+            raise ValueError(
+                f"invalid scene: a value is not finite (NaN or infinity): {e}"
+            ) from None
+        except TypeError as e:
+            raise ValueError(f"invalid scene: {e}") from None
     if isinstance(scene, (str, os.PathLike)):
         return os.fspath(scene), None
     raise ValueError(

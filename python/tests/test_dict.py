@@ -58,3 +58,32 @@ def test_sweep_edits_the_dict(cli, tmp_path):
         ref = cli.json("flat", "--scene", path, "--method", "expectation",
                        "--paths", 100_000, "--seed", 3)
         assert_same(py, ref)
+
+
+def test_numpy_values_are_plain_values():
+    """A sweep built with numpy (arrays of vertices, numpy scalars) is the
+    same scene as its lists and floats."""
+    np = pytest.importorskip("numpy")
+    base = load("occluder.toml")
+    scene = copy.deepcopy(base)
+    occ = next(s for s in scene["shapes"] if s["name"] == "occluder")
+    occ["vertices"] = np.array(occ["vertices"]) + np.array([0.0, np.float64(0.1)])
+    scene["sensor"]["point"] = [np.float32(0.0), np.int64(0)]
+    plain = copy.deepcopy(base)
+    occ = next(s for s in plain["shapes"] if s["name"] == "occluder")
+    occ["vertices"] = [[x, y + 0.1] for x, y in occ["vertices"]]
+    assert_same(
+        geosens.flat(scene, "rendering", paths=50_000, seed=4),
+        geosens.flat(plain, "rendering", paths=50_000, seed=4),
+    )
+
+
+def test_a_dict_that_is_no_scene_value_is_a_value_error():
+    scene = load("occluder.toml")
+    scene["shapes"][1]["vertices"][0][0] = float("nan")
+    with pytest.raises(ValueError, match="not finite"):
+        geosens.flat(scene, "rendering", paths=1000)
+    scene = load("occluder.toml")
+    scene["sensor"]["point"] = {1, 2}
+    with pytest.raises(ValueError, match="invalid scene: set is not a scene value"):
+        geosens.flat(scene, "rendering", paths=1000)
