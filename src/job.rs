@@ -4,6 +4,31 @@
 //! shards of a run ([`crate::shard`]) build their estimator here, so they
 //! estimate the same thing, refuse the same input with the same message, and
 //! print the same [`Report`].
+//!
+//! ```
+//! use geosens::job::{Job, SceneSource, Target};
+//! use geosens::shard::{Merged, Shard, merge};
+//! use geosens::{Method, RunConfig};
+//!
+//! let job = Job {
+//!     target: Target::Flat(SceneSource::File("scenes/occluder.toml".into())),
+//!     method: Some(Method::Expectation),
+//!     fd_step: None,
+//! };
+//! let cfg = RunConfig::new(100_000, 7)?;
+//! let single = job.run(&cfg)?;
+//! // The same run in two shards (two processes, two machines), merged.
+//! let states = [1, 2].map(|i| job.run_shard(&cfg, Shard::new(i, 2).unwrap()));
+//! let labelled: Vec<_> = states
+//!     .into_iter()
+//!     .enumerate()
+//!     .map(|(i, s)| Ok((format!("shard {}", i + 1), s?)))
+//!     .collect::<Result<_, geosens::Error>>()?;
+//! let Merged::Probe(merged) = merge(&labelled)? else { unreachable!() };
+//! assert_eq!(merged.result.estimates, single.result.estimates);
+//! println!("{}", single.json()?); // what `geosens flat --json` prints
+//! # Ok::<(), geosens::Error>(())
+//! ```
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::method::{Method, Problem};
@@ -183,20 +208,6 @@ impl Canonical {
 }
 
 impl Job {
-    /// A job on a scene file: flatland or 3D by its sensor's point.
-    pub fn scene_file(path: impl Into<PathBuf>, method: Method, fd_step: Option<f64>) -> Job {
-        let source = SceneSource::File(path.into());
-        let target = match source.dimension() {
-            Ok(2) => Target::Flat(source),
-            _ => Target::Mesh(source),
-        };
-        Job {
-            target,
-            method: Some(method),
-            fd_step,
-        }
-    }
-
     /// Builds the estimator, checking every input: the rod and probe, the
     /// scene (and that its dimension matches the target), that `fd_step`
     /// goes with `fd`, that the sensor is not a camera (its images come from
