@@ -47,9 +47,11 @@ pub enum Phase {
     },
 }
 
-/// A homogeneous medium filling a closed shape.
+/// A homogeneous medium filling a closed shape. A file gives its phase
+/// function as `phase = { kind = …, g = … }` or, as 3D files do, as `g` (0:
+/// isotropic), not both.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "repr::Medium")]
 pub struct Medium {
     /// Scattering coefficient κs ≥ 0.
     pub ks: f64,

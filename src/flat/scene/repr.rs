@@ -75,6 +75,39 @@ pub enum Phase {
     },
 }
 
+/// A medium as a file gives it: flatland's `phase` table or 3D's `g`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Medium {
+    ks: f64,
+    ke: f64,
+    #[serde(default)]
+    phase: Option<super::Phase>,
+    #[serde(default)]
+    g: Option<f64>,
+}
+
+impl TryFrom<Medium> for super::Medium {
+    type Error = String;
+
+    fn try_from(m: Medium) -> Result<Self, String> {
+        let phase = match (m.phase, m.g) {
+            (Some(_), Some(_)) => {
+                return Err("a medium takes `phase` or `g` (the 3D spelling), not both".into());
+            }
+            (Some(p), None) => p,
+            (None, Some(0.0)) => super::Phase::Isotropic,
+            (None, Some(g)) => super::Phase::HenyeyGreenstein { g },
+            (None, None) => super::Phase::Isotropic,
+        };
+        Ok(super::Medium {
+            ks: m.ks,
+            ke: m.ke,
+            phase,
+        })
+    }
+}
+
 impl From<Phase> for super::Phase {
     fn from(p: Phase) -> Self {
         match p {

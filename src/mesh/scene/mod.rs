@@ -28,9 +28,10 @@ pub use validate::{DEGENERATE_AREA, TOUCH_DISTANCE};
 pub use crate::path::Surface;
 
 /// A homogeneous medium filling a closed mesh, with a Henyey–Greenstein
-/// phase function (`g = 0`: isotropic).
+/// phase function (`g = 0`: isotropic). A file gives it as `g` or, as
+/// flatland files do, as `phase = { kind = …, g = … }`, not both.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "MediumFile")]
 pub struct Medium {
     /// Scattering coefficient κs ≥ 0.
     pub ks: f64,
@@ -39,6 +40,40 @@ pub struct Medium {
     /// Mean cosine of the Henyey–Greenstein phase function, `|g| < 1`.
     #[serde(default)]
     pub g: f64,
+}
+
+/// A medium as a file gives it: 3D's `g` or flatland's `phase` table.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MediumFile {
+    ks: f64,
+    ke: f64,
+    #[serde(default)]
+    g: Option<f64>,
+    #[serde(default)]
+    phase: Option<crate::flat::Phase>,
+}
+
+impl TryFrom<MediumFile> for Medium {
+    type Error = String;
+
+    fn try_from(m: MediumFile) -> Result<Self, String> {
+        let g = match (m.g, m.phase) {
+            (Some(_), Some(_)) => {
+                return Err(
+                    "a medium takes `g` or `phase` (the flatland spelling), not both".into(),
+                );
+            }
+            (Some(g), None) => g,
+            (None, Some(crate::flat::Phase::HenyeyGreenstein { g })) => g,
+            (None, Some(crate::flat::Phase::Isotropic) | None) => 0.0,
+        };
+        Ok(Medium {
+            ks: m.ks,
+            ke: m.ke,
+            g,
+        })
+    }
 }
 
 /// A triangle mesh (after [`Scene::new`]: welded by position, every
