@@ -236,6 +236,19 @@ impl State {
         serde_json::from_str(text).map_err(|e| Error::Merge(format!("a malformed state: {e}")))
     }
 
+    /// Writes the state to `path` as one line of JSON, through a temporary
+    /// file beside it (`FILE.part`, renamed when complete), so that a shard
+    /// killed while writing leaves no file that looks whole.
+    pub fn write(&self, path: &std::path::Path) -> Result<(), Error> {
+        let cannot =
+            |e: std::io::Error| Error::Output(format!("cannot write {}: {e}", path.display()));
+        let mut tmp = path.as_os_str().to_owned();
+        tmp.push(".part");
+        let tmp = std::path::PathBuf::from(tmp);
+        std::fs::write(&tmp, self.to_json()? + "\n").map_err(cannot)?;
+        std::fs::rename(&tmp, path).map_err(cannot)
+    }
+
     /// Reads the state `text` named `name` in messages (its file), with
     /// the messages `geosens merge` prints: `NAME: not a geosens state …`.
     pub fn named(name: &str, text: &str) -> Result<State, Error> {

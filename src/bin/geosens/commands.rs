@@ -50,7 +50,7 @@ fn estimate(
     }
     let which = shard.shard.unwrap_or(Shard::WHOLE);
     let state = job.run_shard(&cfg, which)?;
-    write_state(path, &state)?;
+    state.write(path)?;
     eprintln!(
         "wrote shard {which} ({} of {} paths, {:.2} s) to {}",
         state.paths,
@@ -59,17 +59,6 @@ fn estimate(
         path.display()
     );
     Ok(())
-}
-
-/// Writes `state` to `path` (through a temporary file beside it, so that a
-/// killed shard leaves no half-written state).
-pub(super) fn write_state(path: &std::path::Path, state: &State) -> Result<(), Error> {
-    let cannot = |e: std::io::Error| Error::Output(format!("cannot write {}: {e}", path.display()));
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".part");
-    let tmp = std::path::PathBuf::from(tmp);
-    std::fs::write(&tmp, state.to_json()? + "\n").map_err(cannot)?;
-    std::fs::rename(&tmp, path).map_err(cannot)
 }
 
 /// Prints `report`: its warnings on stderr, its JSON line or table on `out`.

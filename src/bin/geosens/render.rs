@@ -134,7 +134,7 @@ pub(super) fn render_command(
         }
         let which = args.shard.shard.unwrap_or(Shard::WHOLE);
         let state = job.run_shard(args.spp, args.seed, args.threads, which, &|_| {})?;
-        super::commands::write_state(path, &state)?;
+        state.write(path)?;
         eprintln!(
             "wrote shard {which} ({} paths) to {}",
             state.paths,
