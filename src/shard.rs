@@ -407,6 +407,9 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
     };
     let this_version = env!("CARGO_PKG_VERSION");
     let n = first.run.shards;
+    // The count comes from a file: checked before a slot per shard is
+    // allocated (a damaged count must be an error, not an abort).
+    Shard::new(first.shard, n).map_err(|e| Error::Merge(format!("{first_label}: {e}")))?;
     let mut by_index: Vec<Option<&(String, State)>> = vec![None; n as usize];
     for pair in labelled {
         let (label, s) = pair;

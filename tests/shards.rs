@@ -334,6 +334,13 @@ fn states_that_are_not_one_whole_run_are_refused() {
         err.contains("should hold blocks") && err.contains("damaged"),
         "{err}"
     );
+    // A shard count no run has (it would allocate a slot per shard).
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(s1).unwrap()).unwrap();
+    v["run"]["shards"] = Value::from(u64::MAX);
+    let huge = dir.join("huge.json");
+    std::fs::write(&huge, v.to_string()).unwrap();
+    let err = refused(&["merge", huge.to_str().unwrap()]);
+    assert!(err.contains("huge.json") && err.contains("I/N"), "{err}");
     // Not a state at all, and no file.
     let err = refused(&["merge", &occluder]);
     assert!(
