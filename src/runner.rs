@@ -175,11 +175,7 @@ fn run_blocks<E: Estimator + ?Sized>(
                 .collect()
         };
         for block in per_chunk.chunks(BLOCK as usize) {
-            let mut total = vec![Moments::default(); nq];
-            for chunk in block {
-                merge_into(&mut total, chunk);
-            }
-            sink(total);
+            sink(fold_blocks(nq, block.iter().map(Vec::as_slice)));
         }
         first = last;
     }

@@ -35,10 +35,6 @@ use std::io::{self, Write};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Most worker threads accepted by `--threads`: beyond it a pool would cost
-/// more to start than the runs it serves (and rayon itself stops at 65535).
-const MAX_THREADS: usize = 1024;
-
 /// Monte Carlo estimates of intensity and geometric sensitivities.
 #[derive(Debug, Parser)]
 #[command(name = "geosens", version, about)]
@@ -206,14 +202,9 @@ struct RunArgs {
 
 impl RunArgs {
     /// The validated configuration, `default_paths` if `--paths` is absent,
-    /// with `--threads` capped at [`MAX_THREADS`].
+    /// with `--threads` checked first ([`geosens::runner::check_threads`]).
     fn config(&self, default_paths: u64) -> Result<RunConfig, Error> {
-        if self.threads > MAX_THREADS {
-            return Err(Error::Config(format!(
-                "threads = {}: expected 0 (all cores) to {MAX_THREADS}",
-                self.threads
-            )));
-        }
+        geosens::runner::check_threads(self.threads)?;
         let cfg = RunConfig::new(self.paths.unwrap_or(default_paths), self.seed)?;
         Ok(cfg.threads(self.threads))
     }

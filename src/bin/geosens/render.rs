@@ -112,13 +112,7 @@ pub(super) fn render_command(
     args: &RenderArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    if args.threads > MAX_THREADS {
-        return Err(Error::Config(format!(
-            "threads = {}: expected 0 (all cores) to {MAX_THREADS}",
-            args.threads
-        ))
-        .into());
-    }
+    geosens::runner::check_threads(args.threads)?;
     let job = RenderJob {
         scene: SceneSource::File(args.scene.clone()),
         method: args.method,
