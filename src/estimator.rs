@@ -26,6 +26,13 @@ use std::fmt;
 /// terms would itself be mostly rounding.
 pub const ROUNDING: f64 = 1e-13;
 
+/// Whether `value`, computed from terms whose sizes add up to `scale`, is
+/// their rounding residue ([`ROUNDING`]): then it is taken for 0.
+#[inline]
+pub fn within_rounding(value: f64, scale: f64) -> bool {
+    value.abs() <= ROUNDING * scale
+}
+
 /// What one weight slot estimates.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(tag = "kind", content = "name", rename_all = "snake_case")]

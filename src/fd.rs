@@ -198,7 +198,7 @@ impl Estimator for CentralDifference {
             let diff = plus - minus;
             // Two paths that differ only by the rounding of the displaced
             // geometry give a difference of roundoff, not a derivative.
-            *w = if diff.abs() <= crate::estimator::ROUNDING * (plus.abs() + minus.abs()) {
+            *w = if crate::estimator::within_rounding(diff, plus.abs() + minus.abs()) {
                 0.0
             } else {
                 diff / (2.0 * pair.half_step)

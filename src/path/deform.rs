@@ -13,7 +13,7 @@
 use super::rendering::Rendering;
 use super::walk::{Vertex, light_sample, transmittance};
 use super::{Boundaries, Geometry, Hit, Vector};
-use crate::estimator::ROUNDING;
+use crate::estimator::within_rounding;
 use crate::rng::PathRng;
 
 /// Most derivative slots a walk carries (shape parameters plus the sensor's
@@ -104,7 +104,7 @@ pub struct Slot<V: Vector> {
     /// Boundary terms collected so far (and, at the end, the derivative).
     pub boundary: f64,
     /// Σ|terms| of `boundary` (a term's own scale where it carries one):
-    /// a derivative below [`ROUNDING`] times it is rounding, not signal.
+    /// a derivative below [`ROUNDING`](crate::estimator::ROUNDING) times it is rounding, not signal.
     pub boundary_scale: f64,
     /// `ṫ_b` of the current segment.
     pub tb_dot: f64,
@@ -129,10 +129,10 @@ impl<V: Vector> Slot<V> {
     }
 
     /// The derivative collected: `boundary`, or 0 where it is below the
-    /// rounding of its terms ([`ROUNDING`]).
+    /// rounding of its terms ([`ROUNDING`](crate::estimator::ROUNDING)).
     #[inline]
     pub fn derivative(&self) -> f64 {
-        if self.boundary.abs() <= ROUNDING * self.boundary_scale {
+        if within_rounding(self.boundary, self.boundary_scale) {
             0.0
         } else {
             self.boundary
@@ -245,7 +245,7 @@ impl<V: Vector> Deform<V> {
             // slab translated along its normal) leaves only the rounding of
             // the speeds subtracted: that is 0, not a tiny signal.
             let speeds = v.length() + s.u.length() + s.wd.length() * h.t;
-            s.tb_dot = if along.abs() <= ROUNDING * speeds {
+            s.tb_dot = if within_rounding(along, speeds) {
                 0.0
             } else {
                 along / wn
