@@ -132,7 +132,33 @@ impl SceneSource {
             SceneSource::Json(text) => mesh::file::from_json(text),
         }
     }
+
+    /// The flatland (`flat`) or 3D scene's estimator of `method`, with the
+    /// scene's numbers of shapes and parameters and what a shard hashes.
+    fn estimator(
+        &self,
+        flat: bool,
+        method: Method,
+        fd_step: Option<f64>,
+    ) -> Result<SceneEstimator, Error> {
+        let path = self.path();
+        if flat {
+            let scene = Arc::new(self.flat()?);
+            let sizes = (scene.shapes().len(), scene.parameters().len());
+            let est = estimator_of(method, Arc::clone(&scene), fd_step, path)?;
+            Ok((est, sizes, Canonical::Flat(scene)))
+        } else {
+            let scene = Arc::new(self.mesh()?);
+            let sizes = (scene.shapes().len(), scene.parameters().len());
+            let est = estimator_of(method, Arc::clone(&scene), fd_step, path)?;
+            Ok((est, sizes, Canonical::Mesh(scene)))
+        }
+    }
 }
+
+/// A scene's estimator, its numbers of shapes and parameters, and what a
+/// shard of its run hashes.
+type SceneEstimator = (Box<dyn Estimator>, (usize, usize), Canonical);
 
 /// What a job estimates on.
 #[derive(Debug, Clone, PartialEq)]
@@ -214,12 +240,7 @@ impl Job {
     /// `geosens render`).
     pub fn prepare(&self) -> Result<Prepared, Error> {
         let method = self.method;
-        if self.fd_step.is_some() && method != Some(Method::Fd) {
-            let name = method.map_or("exact", Method::name);
-            return Err(Error::Config(format!(
-                "--fd-step sets the half step of --method fd, not of {name}"
-            )));
-        }
+        check_fd_step(method, self.fd_step)?;
         match &self.target {
             Target::Rod(given) => {
                 let (rod, probe) = given.build()?;
@@ -241,17 +262,8 @@ impl Job {
                 let m = method.ok_or_else(|| {
                     Error::Config("the exact solution is the rod's only (--method exact)".into())
                 })?;
-                let (estimator, shapes, parameters, canonical) = if flat {
-                    let scene = Arc::new(source.flat()?);
-                    let sizes = (scene.shapes().len(), scene.parameters().len());
-                    let est = estimator_of(m, Arc::clone(&scene), self.fd_step, source.path())?;
-                    (est, sizes.0, sizes.1, Canonical::Flat(scene))
-                } else {
-                    let scene = Arc::new(source.mesh()?);
-                    let sizes = (scene.shapes().len(), scene.parameters().len());
-                    let est = estimator_of(m, Arc::clone(&scene), self.fd_step, source.path())?;
-                    (est, sizes.0, sizes.1, Canonical::Mesh(scene))
-                };
+                let (estimator, (shapes, parameters), canonical) =
+                    source.estimator(flat, m, self.fd_step)?;
                 if estimator.image().is_some() {
                     return Err(Error::Config(format!(
                         "{}: the sensor is a camera: its images come from `geosens render`",
@@ -288,6 +300,18 @@ impl Job {
             caveats: prepared.caveats,
         })
     }
+}
+
+/// Errors if `fd_step` is given for a method other than [`Method::Fd`]
+/// (`None`: the rod's exact solution).
+fn check_fd_step(method: Option<Method>, fd_step: Option<f64>) -> Result<(), Error> {
+    if fd_step.is_some() && method != Some(Method::Fd) {
+        let name = method.map_or("exact", Method::name);
+        return Err(Error::Config(format!(
+            "--fd-step sets the half step of --method fd, not of {name}"
+        )));
+    }
+    Ok(())
 }
 
 /// `method`'s estimator on `problem` with `fd_step`. An invalid displaced
@@ -349,22 +373,9 @@ impl RenderJob {
     /// Builds the estimator (flatland or 3D by the scene's dimension) and
     /// checks that the sensor is a camera.
     pub fn prepare(&self) -> Result<(Box<dyn Estimator>, Canonical), Error> {
-        if self.fd_step.is_some() && self.method != Method::Fd {
-            return Err(Error::Config(format!(
-                "--fd-step sets the half step of --method fd, not of {}",
-                self.method
-            )));
-        }
-        let path = self.scene.path();
-        let (est, canonical) = if self.scene.dimension()? == 2 {
-            let scene = Arc::new(self.scene.flat()?);
-            let est = estimator_of(self.method, Arc::clone(&scene), self.fd_step, path)?;
-            (est, Canonical::Flat(scene))
-        } else {
-            let scene = Arc::new(self.scene.mesh()?);
-            let est = estimator_of(self.method, Arc::clone(&scene), self.fd_step, path)?;
-            (est, Canonical::Mesh(scene))
-        };
+        check_fd_step(Some(self.method), self.fd_step)?;
+        let flat = self.scene.dimension()? == 2;
+        let (est, _, canonical) = self.scene.estimator(flat, self.method, self.fd_step)?;
         if est.image().is_none() {
             return Err(Error::Config(format!(
                 "{}: the scene's sensor is not a camera: an image needs `[sensor] kind = \"camera\"` \
