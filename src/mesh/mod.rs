@@ -8,7 +8,8 @@
 //! - [`bvh`]: ray casting through obvhs, every hit re-tested in f64;
 //! - [`space`]: the scene behind the path core's `Geometry`; [`lobe`]: the
 //!   3D lobes; [`boundaries`]: the edges behind `Boundaries`; [`warp`]: the
-//!   expectation method's fibre warp;
+//!   expectation method's fibre warp; [`sensor_view`]: what the sensor's
+//!   point sees of every edge (the warp's knots there without shadow rays);
 //! - [`camera`]: the pinhole camera (pixels as lobes, the edges each
 //!   pixel sees);
 //! - [`methods`]: the estimators; [`exact`]: closed-form references;
@@ -26,6 +27,7 @@ pub mod file;
 pub mod lobe;
 pub mod methods;
 pub mod scene;
+pub mod sensor_view;
 pub mod space;
 pub mod warp;
 

@@ -9,6 +9,7 @@ use super::camera::{CameraFrame, PixelEdges};
 use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
 use super::scene::{Scene, Sensor as SceneSensor};
+use super::sensor_view::SensorView;
 use super::warp::{MAX_FIELDS, PoleRule};
 use crate::path::{Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
@@ -59,6 +60,9 @@ pub struct Space {
     /// on first use, by the derivative methods).
     pub(super) camera: Option<CameraFrame>,
     pixel_edges: OnceLock<PixelEdges>,
+    /// What the sensor's point sees of the edges (built on first use, by
+    /// the expectation method; `None` for a scene too large for it).
+    sensor_view: OnceLock<Option<SensorView>>,
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
     pub(super) pole_rules: Vec<PoleRule>,
@@ -159,6 +163,7 @@ impl Space {
             edge_tables: OnceLock::new(),
             camera,
             pixel_edges: OnceLock::new(),
+            sensor_view: OnceLock::new(),
             pole_rules,
             slot_field,
         }
@@ -179,6 +184,32 @@ impl Space {
     pub(super) fn edge_tables(&self) -> &EdgeTables {
         self.edge_tables
             .get_or_init(|| EdgeTables::new(&self.scene, &self.normals))
+    }
+
+    /// What the sensor's point (a probe's point, a camera's pinhole) sees
+    /// of the edges, built on first use; `None` when the scene is too large
+    /// for it ([`super::sensor_view::MAX_PAIRS`]).
+    #[inline]
+    pub(super) fn sensor_view(&self) -> Option<&SensorView> {
+        self.sensor_view
+            .get_or_init(|| {
+                let t = self.edge_tables();
+                let opaque: Vec<(Prim, [DVec3; 3])> = (0..self.tris.len())
+                    .filter(|&i| {
+                        self.scene.shapes()[self.owner[i] as usize]
+                            .surface
+                            .is_opaque()
+                    })
+                    .map(|i| (i as Prim, self.tris[i]))
+                    .collect();
+                SensorView::new(
+                    self.scene.sensor().point(),
+                    &t.edges,
+                    &t.edge_facts,
+                    &opaque,
+                )
+            })
+            .as_ref()
     }
 
     /// The moving meshes' edges each camera pixel sees, built on first use

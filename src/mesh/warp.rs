@@ -31,7 +31,7 @@
 //! per pole rule ([`PoleRule`]), each with its own knot search. Book: chapter "Three dimensions",
 //! section "A warp on the sphere".
 use super::lobe::SpaceLobe;
-use super::space::Space;
+use super::space::{Edge, Space};
 use crate::path::NO_PRIM;
 use crate::path::walk::Vertex;
 use glam::DVec3;
@@ -271,7 +271,9 @@ impl Space {
     // ANCHOR_END: fibre_warp
 
     /// The visible edge crossings of the fibre nearest to θ on either side,
-    /// within the knots `lo` and `hi` already found.
+    /// within the knots `lo` and `hi` already found. At the sensor's point
+    /// the visible parts of the edges are known ([`SensorView`](super::sensor_view::SensorView)): no shadow
+    /// ray.
     #[allow(clippy::too_many_arguments)]
     fn nearest_crossings(
         &self,
@@ -284,6 +286,24 @@ impl Space {
         mut lo: FibreKnot,
         mut hi: FibreKnot,
     ) -> (FibreKnot, FibreKnot) {
+        let edges = &self.edge_tables().edges;
+        if skip == NO_PRIM
+            && let Some(view) = self.sensor_view().filter(|v| v.point == x)
+        {
+            for (k, &i) in view.edges.iter().enumerate() {
+                let Some((knot, t)) = crossing(&edges[i as usize], x, p, u, m) else {
+                    continue;
+                };
+                let cos = knot.cos;
+                if cos > cos_theta && cos < lo.cos && view.sees(k, t) {
+                    lo = knot;
+                }
+                if cos < cos_theta && cos > hi.cos && view.sees(k, t) {
+                    hi = knot;
+                }
+            }
+            return (lo, hi);
+        }
         // Candidates are tried nearest first; a hidden one moves the bound
         // past it and the scan runs again. Angles are compared by their
         // cosines (θ ∈ [0, π] grows as cos θ falls).
@@ -295,33 +315,13 @@ impl Space {
                 x,
                 m,
                 u,
-                &self.edge_tables().edges,
+                edges,
                 &self.edge_tables().edge_facts,
                 |i| {
-                    let e = &self.edge_tables().edges[i as usize];
-                    let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
-                    if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
+                    let Some((knot, _)) = crossing(&edges[i as usize], x, p, u, m) else {
                         return;
-                    }
-                    let t = sa / (sa - sb);
-                    let q = e.a + (e.b - e.a) * t;
-                    let d = q - x;
-                    let (dp, du) = (d.dot(p), d.dot(u));
-                    if du <= 0.0 {
-                        return; // the other half of the great circle
-                    }
-                    let cos = dp / d.length();
-                    let knot = FibreKnot {
-                        cos,
-                        edge: Some(Crossing {
-                            q,
-                            dir: e.b - e.a,
-                            shape: e.shape,
-                            e_theta: DVec3::ZERO,
-                            inv_r: 0.0,
-                            inv_across: 0.0,
-                        }),
                     };
+                    let cos = knot.cos;
                     if !done_lo
                         && cos > bound_lo
                         && cos < lo.cos
@@ -429,4 +429,34 @@ impl Space {
             }
         }
     }
+}
+
+/// Where the plane through `x` of normal `m` crosses the edge `e` on the
+/// fibre's side (`u`), as a knot (its rates' fields left to fill) and the
+/// edge parameter there.
+#[inline]
+fn crossing(e: &Edge, x: DVec3, p: DVec3, u: DVec3, m: DVec3) -> Option<(FibreKnot, f64)> {
+    let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
+    if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
+        return None;
+    }
+    let t = sa / (sa - sb);
+    let q = e.a + (e.b - e.a) * t;
+    let d = q - x;
+    let (dp, du) = (d.dot(p), d.dot(u));
+    if du <= 0.0 {
+        return None; // the other half of the great circle
+    }
+    let knot = FibreKnot {
+        cos: dp / d.length(),
+        edge: Some(Crossing {
+            q,
+            dir: e.b - e.a,
+            shape: e.shape,
+            e_theta: DVec3::ZERO,
+            inv_r: 0.0,
+            inv_across: 0.0,
+        }),
+    };
+    Some((knot, t))
 }

@@ -1,0 +1,214 @@
+//! What the sensor's fixed point sees of every discontinuity edge: the
+//! visible parts of each edge, as parameter intervals, computed once per
+//! scene. The expectation method's warp at the sensor (an irradiance or
+//! radiance probe, or a camera's pinhole: every path starts there) then
+//! finds its knots with no shadow ray: a crossing of a fibre's plane with an
+//! edge is a knot when its parameter lies in a visible interval. This is the
+//! 3D twin of flatland's precomputed sensor knots (the sensor does not
+//! move). Book: chapter "Three dimensions", section "A warp on the sphere".
+//!
+//! Why an edge's hidden part behind one triangle is one interval: with
+//! `r(t) = a + t(b − a) − s` the sight line from the sensor `s` to the
+//! edge's point at `t`, the point is behind the triangle when `r(t)` lies in
+//! the triangle's cone from `s` (three half-spaces, each linear in `t`) and
+//! the triangle's plane cuts the sight line before its end (`|r(t)·N| >
+//! |(v₀ − s)·N|` with the same sign, linear in `t` too). An intersection of
+//! half-lines is an interval; the visible parts are the complement of the
+//! union over triangles. A triangle on the edge (its own faces) cannot hide
+//! it and is skipped.
+use super::edges::{EdgeFacts, is_discontinuity};
+use super::space::Edge;
+use crate::path::Prim;
+use glam::DVec3;
+
+/// Most edge × triangle pairs the view is computed from; beyond, the warp
+/// keeps its shadow rays (a large mesh: the pairs would cost more than the
+/// rays they save on a short run).
+pub const MAX_PAIRS: usize = 20_000_000;
+
+/// The visible parts of the discontinuity edges seen from one point.
+#[derive(Debug, Clone, Default)]
+pub struct SensorView {
+    /// The point.
+    pub point: DVec3,
+    /// The edges with a visible part, in index order.
+    pub edges: Vec<u32>,
+    /// Per entry of `edges`, its visible intervals: `pieces[start[i]..start[i + 1]]`.
+    start: Vec<u32>,
+    pieces: Vec<[f64; 2]>,
+}
+
+impl SensorView {
+    /// The view from `s` of the `edges` that are discontinuities from `s`,
+    /// occluded by the `opaque` triangles (with their primitive indices);
+    /// `None` when that needs more than [`MAX_PAIRS`] edge-triangle tests.
+    pub fn new(
+        s: DVec3,
+        edges: &[Edge],
+        facts: &[EdgeFacts],
+        opaque: &[(Prim, [DVec3; 3])],
+    ) -> Option<SensorView> {
+        let seen: Vec<u32> = (0..edges.len() as u32)
+            .filter(|&i| is_discontinuity(&edges[i as usize], &facts[i as usize], s))
+            .collect();
+        if seen.len().saturating_mul(opaque.len()) > MAX_PAIRS {
+            return None;
+        }
+        let mut view = SensorView {
+            point: s,
+            edges: Vec::new(),
+            start: vec![0],
+            pieces: Vec::new(),
+        };
+        let mut hidden: Vec<[f64; 2]> = Vec::new();
+        for i in seen {
+            let e = &edges[i as usize];
+            hidden.clear();
+            for (p, t) in opaque {
+                if e.faces.contains(p) {
+                    continue;
+                }
+                if let Some(h) = hidden_interval(s, e.a, e.b, t) {
+                    hidden.push(h);
+                }
+            }
+            hidden.sort_by(|x, y| x[0].total_cmp(&y[0]));
+            let before = view.pieces.len();
+            let mut from = 0.0;
+            for h in &hidden {
+                if h[0] > from {
+                    view.pieces.push([from, h[0]]);
+                }
+                from = f64::max(from, h[1]);
+            }
+            if from < 1.0 {
+                view.pieces.push([from, 1.0]);
+            }
+            if view.pieces.len() > before {
+                view.edges.push(i);
+                view.start.push(view.pieces.len() as u32);
+            }
+        }
+        Some(view)
+    }
+
+    /// The visible intervals of the `k`-th edge of [`Self::edges`].
+    #[inline]
+    pub fn pieces(&self, k: usize) -> &[[f64; 2]] {
+        &self.pieces[self.start[k] as usize..self.start[k + 1] as usize]
+    }
+
+    /// Whether the point at parameter `t` of the `k`-th edge of
+    /// [`Self::edges`] is seen.
+    #[inline]
+    pub fn sees(&self, k: usize, t: f64) -> bool {
+        self.pieces(k).iter().any(|p| t >= p[0] && t <= p[1])
+    }
+}
+
+/// The open interval of `t ∈ [0, 1]` for which the triangle `tri` lies
+/// strictly between `s` and `a + t(b − a)`, if not empty.
+fn hidden_interval(s: DVec3, a: DVec3, b: DVec3, tri: &[DVec3; 3]) -> Option<[f64; 2]> {
+    let (r0, d) = (a - s, b - a);
+    let w = [tri[0] - s, tri[1] - s, tri[2] - s];
+    let normal = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+    let depth = w[0].dot(normal);
+    if depth == 0.0 {
+        return None; // `s` in the triangle's plane: it hides nothing
+    }
+    let orient = w[0].dot(w[1].cross(w[2])).signum();
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    // Each constraint `c0 + t·c1 > 0` narrows (lo, hi).
+    let mut keep = |c0: f64, c1: f64| {
+        if c1 > 0.0 {
+            lo = lo.max(-c0 / c1);
+        } else if c1 < 0.0 {
+            hi = hi.min(-c0 / c1);
+        } else if c0 <= 0.0 {
+            hi = f64::NEG_INFINITY;
+        }
+    };
+    for i in 0..3 {
+        let n = orient * w[(i + 1) % 3].cross(w[(i + 2) % 3]);
+        keep(r0.dot(n), d.dot(n));
+    }
+    let sign = depth.signum();
+    keep(sign * r0.dot(normal) - sign * depth, sign * d.dot(normal));
+    (lo < hi).then_some([lo, hi])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// Whether the point is hidden, by a brute-force segment test.
+    fn hidden_by_rays(s: DVec3, q: DVec3, tris: &[(Prim, [DVec3; 3])], own: [Prim; 2]) -> bool {
+        tris.iter().any(|(p, t)| {
+            if own.contains(p) {
+                return false;
+            }
+            let d = q - s;
+            super::super::bvh::intersect(t, s, d).is_some_and(|l| l > 0.0 && l < 1.0)
+        })
+    }
+
+    #[test]
+    fn intervals_agree_with_shadow_rays() {
+        let mut rng = crate::rng::PathRng::seed_from_u64(5);
+        let mut p = |r: f64| {
+            DVec3::new(
+                rng.random::<f64>() * 2.0 * r - r,
+                rng.random::<f64>() * 2.0 * r - r,
+                rng.random::<f64>() * 2.0,
+            )
+        };
+        let tris: Vec<(Prim, [DVec3; 3])> = (0..40)
+            .map(|i| {
+                // Near z = 0.5..1.5, edges beyond: many are partly hidden.
+                let c = p(1.0) * DVec3::new(1.0, 1.0, 0.5) + DVec3::Z * 0.5;
+                let mut corner = || c + p(0.5) * DVec3::new(1.0, 1.0, 0.1);
+                (i, [corner(), corner(), corner()])
+            })
+            .collect();
+        let edges: Vec<Edge> = (0..60)
+            .map(|_| Edge {
+                a: p(1.5) + DVec3::Z,
+                b: p(1.5) + DVec3::Z,
+                faces: [1000, crate::path::NO_PRIM],
+                shape: 0,
+            })
+            .collect();
+        let facts = vec![
+            EdgeFacts {
+                normals: [DVec3::Z; 2],
+                always: true
+            };
+            edges.len()
+        ];
+        let s = DVec3::new(0.1, -0.2, -0.5);
+        let view = SensorView::new(s, &edges, &facts, &tris).unwrap();
+        let (mut seen, mut hidden) = (0, 0);
+        for (i, e) in edges.iter().enumerate() {
+            let k = view.edges.iter().position(|&j| j == i as u32);
+            for step in 0..=200 {
+                let t = step as f64 / 200.0;
+                let q = e.a + (e.b - e.a) * t;
+                let rays = hidden_by_rays(s, q, &tris, e.faces);
+                // Off the intervals' ends, where rounding decides.
+                let near_end = k.is_some_and(|k| {
+                    view.pieces(k)
+                        .iter()
+                        .any(|p| (t - p[0]).abs() < 1e-9 || (t - p[1]).abs() < 1e-9)
+                });
+                if near_end {
+                    continue;
+                }
+                let sees = k.is_some_and(|k| view.sees(k, t));
+                assert_eq!(sees, !rays, "edge {i} at t = {t}");
+                if rays { hidden += 1 } else { seen += 1 }
+            }
+        }
+        assert!(seen > 1000 && hidden > 1000, "{seen} {hidden}");
+    }
+}
