@@ -64,9 +64,11 @@ pub struct Crossing {
     inv_across: f64,
 }
 
-/// Most fibre families one warp builds (distinct poles); parameters beyond
-/// share the pseudo-random one.
-pub const MAX_FIELDS: usize = 6;
+/// Most fibre families one warp builds (distinct poles): the motions use at
+/// most four rules (the pseudo-random pole and the three axes); parameters
+/// beyond would share the pseudo-random one. Small, because a warp is
+/// copied per vertex.
+pub const MAX_FIELDS: usize = 4;
 
 /// How a parameter's fibres are laid out from a vertex `x`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -304,13 +306,15 @@ impl Space {
             }
             return (lo, hi);
         }
-        // Candidates are tried nearest first; a hidden one moves the bound
-        // past it and the scan runs again. Angles are compared by their
-        // cosines (θ ∈ [0, π] grows as cos θ falls).
+        // One scan keeps each side's nearest candidates in order; they are
+        // tried nearest first, and only when all of a full list are hidden
+        // does the side scan again past them. Angles are compared by their
+        // cosines (θ ∈ [0, π] grows as cos θ falls); a side's key grows
+        // away from θ.
         let (mut bound_lo, mut bound_hi) = (cos_theta, cos_theta);
         let (mut done_lo, mut done_hi) = (false, false);
         while !(done_lo && done_hi) {
-            let (mut best_lo, mut best_hi): (Option<FibreKnot>, Option<FibreKnot>) = (None, None);
+            let (mut near_lo, mut near_hi) = (Nearest::new(), Nearest::new());
             self.edge_tables().all_edges.crossings(
                 x,
                 m,
@@ -322,42 +326,34 @@ impl Space {
                         return;
                     };
                     let cos = knot.cos;
-                    if !done_lo
-                        && cos > bound_lo
-                        && cos < lo.cos
-                        && best_lo.is_none_or(|b| cos < b.cos)
-                    {
-                        best_lo = Some(knot);
+                    if !done_lo && cos > bound_lo && cos < lo.cos {
+                        near_lo.insert(cos, knot);
                     }
-                    if !done_hi
-                        && cos < bound_hi
-                        && cos > hi.cos
-                        && best_hi.is_none_or(|b| cos > b.cos)
-                    {
-                        best_hi = Some(knot);
+                    if !done_hi && cos < bound_hi && cos > hi.cos {
+                        near_hi.insert(-cos, knot);
                     }
                 },
             );
-            let settle =
-                |done: &mut bool, best: Option<FibreKnot>, bound: &mut f64, k: &mut FibreKnot| {
-                    if *done {
+            let settle = |done: &mut bool, near: &Nearest, bound: &mut f64, k: &mut FibreKnot| {
+                if *done {
+                    return;
+                }
+                for b in near.sorted() {
+                    let q = b.edge.map_or(x, |e| e.q);
+                    if self.visible_point(x, q, skip) {
+                        *k = *b;
+                        *done = true;
                         return;
                     }
-                    match best {
-                        None => *done = true,
-                        Some(b) => {
-                            let q = b.edge.map_or(x, |e| e.q);
-                            if self.visible_point(x, q, skip) {
-                                *k = b;
-                                *done = true;
-                            } else {
-                                *bound = b.cos;
-                            }
-                        }
-                    }
-                };
-            settle(&mut done_lo, best_lo, &mut bound_lo, &mut lo);
-            settle(&mut done_hi, best_hi, &mut bound_hi, &mut hi);
+                }
+                match near.sorted().last() {
+                    // Every candidate hidden: done unless some were left out.
+                    Some(last) if near.full() => *bound = last.cos,
+                    _ => *done = true,
+                }
+            };
+            settle(&mut done_lo, &near_lo, &mut bound_lo, &mut lo);
+            settle(&mut done_hi, &near_hi, &mut bound_hi, &mut hi);
         }
         (lo, hi)
     }
@@ -459,4 +455,65 @@ fn crossing(e: &Edge, x: DVec3, p: DVec3, u: DVec3, m: DVec3) -> Option<(FibreKn
         }),
     };
     Some((knot, t))
+}
+
+/// How many candidate knots a side keeps per scan.
+const NEAREST: usize = 8;
+
+/// The candidate knots nearest to θ on one side, by a key growing away
+/// from θ, in order (ties keep the scan's order).
+struct Nearest {
+    keys: [f64; NEAREST],
+    knots: [FibreKnot; NEAREST],
+    len: usize,
+    /// Some candidate was dropped for lack of room.
+    dropped: bool,
+}
+
+impl Nearest {
+    #[inline]
+    fn new() -> Nearest {
+        Nearest {
+            keys: [f64::INFINITY; NEAREST],
+            knots: [FibreKnot {
+                cos: 0.0,
+                edge: None,
+            }; NEAREST],
+            len: 0,
+            dropped: false,
+        }
+    }
+
+    #[inline]
+    fn insert(&mut self, key: f64, knot: FibreKnot) {
+        let mut i = self.len;
+        if i == NEAREST {
+            if key >= self.keys[NEAREST - 1] {
+                self.dropped = true;
+                return;
+            }
+            self.dropped = true;
+            i -= 1;
+        } else {
+            self.len += 1;
+        }
+        while i > 0 && self.keys[i - 1] > key {
+            self.keys[i] = self.keys[i - 1];
+            self.knots[i] = self.knots[i - 1];
+            i -= 1;
+        }
+        self.keys[i] = key;
+        self.knots[i] = knot;
+    }
+
+    #[inline]
+    fn sorted(&self) -> &[FibreKnot] {
+        &self.knots[..self.len]
+    }
+
+    /// Whether candidates beyond the kept ones exist.
+    #[inline]
+    fn full(&self) -> bool {
+        self.dropped
+    }
 }
