@@ -136,7 +136,12 @@ impl<G: Boundaries> DerivativeEstimator<G> {
                 (reading(g, &mut h, rng, pixel), h.d)
             }
             Scheme::Expectation => {
-                let mut h = Expectation { slots, scratch, d };
+                let mut h = Expectation {
+                    slots,
+                    scratch,
+                    d,
+                    pending: None,
+                };
                 (reading(g, &mut h, rng, pixel), h.d)
             }
             Scheme::Transport => {

@@ -29,6 +29,9 @@ pub struct Expectation<'a, G: Geometry> {
     pub scratch: &'a mut Scratch<G::V>,
     /// The walk's state.
     pub d: Deform<G::V>,
+    /// A direction drawn in vacuum whose warp waits for its ray's hit: a
+    /// path that then ends without light skips it (see [`dead_end`]).
+    pub pending: Option<(Vertex<G>, G::V)>,
 }
 
 // ANCHOR: warp
@@ -60,22 +63,26 @@ fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>
 }
 // ANCHOR_END: warp
 
-/// Whether the path leaving `v` along `w` surely ends without light: in
-/// vacuum, it escapes or meets a black absorber. Its direction's velocity
-/// then multiplies nothing, and the warp (which costs more than this one
-/// ray) is skipped; the estimates are unchanged.
+/// Whether the path that left a vertex in vacuum and met `hit` surely ends
+/// without light: it escaped or met a black absorber. Its direction's
+/// velocity then multiplies nothing, and the warp (which costs more than
+/// the ray) is skipped; the estimates are unchanged.
 #[inline]
-fn dead_end<G: Geometry>(g: &G, v: &Vertex<G>, w: G::V) -> bool {
-    if g.coefficients(v.medium).is_some() {
-        return false;
-    }
-    g.cast(v.x, w, v.skip)
-        .is_none_or(|h| g.surface(h.prim) == super::Surface::Absorber)
+fn dead_end<G: Geometry>(g: &G, hit: Option<Hit>) -> bool {
+    hit.is_none_or(|h| g.surface(h.prim) == super::Surface::Absorber)
 }
 
 impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
+        // The warp of a direction drawn in vacuum, now that its hit is known
+        // (the walk casts the ray once).
+        if let Some((v, drawn)) = self.pending.take() {
+            debug_assert!(drawn == w, "the pending direction is the ray's");
+            if !dead_end(g, hit) {
+                warp(g, self.slots, &mut self.d, &v, w);
+            }
+        }
         self.d.segment(g, self.slots, false, x, w, hit);
     }
     // ANCHOR: collision
@@ -121,8 +128,12 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
         let w = v.lobe.sample(rng);
-        if !self.slots.is_empty() && !dead_end(g, v, w) {
-            warp(g, self.slots, &mut self.d, v, w);
+        if !self.slots.is_empty() {
+            if g.coefficients(v.medium).is_some() {
+                warp(g, self.slots, &mut self.d, v, w);
+            } else {
+                self.pending = Some((*v, w));
+            }
         }
         w
     }

@@ -50,7 +50,7 @@ pub struct Leg<G: Geometry> {
 }
 
 /// A scattering vertex: where it is, what it leaves, its lobe and frame.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug)]
 pub struct Vertex<G: Geometry> {
     /// Position.
     pub x: G::V,
@@ -70,6 +70,16 @@ pub struct Vertex<G: Geometry> {
     /// Whether this is the irradiance sensor (whose warp knots are known).
     pub at_sensor: bool,
 }
+
+// By hand: a derive would ask `G: Copy` of the geometry itself.
+impl<G: Geometry> Clone for Vertex<G> {
+    #[inline]
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<G: Geometry> Copy for Vertex<G> {}
 
 // ANCHOR: hooks
 /// What a method does at the loop's events. Every method is a default
