@@ -1,11 +1,14 @@
-//! What the sensor's fixed point sees of every discontinuity edge: the
-//! visible parts of each edge, as parameter intervals, computed once per
-//! scene. The expectation method's warp at the sensor (an irradiance or
-//! radiance probe, or a camera's pinhole: every path starts there) then
-//! finds its knots with no shadow ray: a crossing of a fibre's plane with an
-//! edge is a knot when its parameter lies in a visible interval. This is the
-//! 3D twin of flatland's precomputed sensor knots (the sensor does not
-//! move). Book: chapter "Three dimensions", section "A warp on the sphere".
+//! What the sensor's fixed point sees of the discontinuity edges, computed
+//! once per scene: the edges that can be discontinuities from there (a
+//! silhouette ring, a few of a large mesh's edges) in an edge tree of their
+//! own, and, when affordable, the visible parts of each as parameter
+//! intervals. The expectation method's warp at the sensor (an irradiance
+//! or radiance probe, or a camera's pinhole: every path starts there) then
+//! searches the small tree, and with the intervals finds its knots with no
+//! shadow ray: a crossing of a fibre's plane with an edge is a knot when
+//! its parameter lies in a visible interval. This is the 3D twin of
+//! flatland's precomputed sensor knots (the sensor does not move). Book:
+//! chapter "Three dimensions", section "A warp on the sphere".
 //!
 //! Why an edge's hidden part behind one triangle is one interval: with
 //! `r(t) = a + t(b − a) − s` the sight line from the sensor `s` to the
@@ -16,52 +19,86 @@
 //! half-lines is an interval; the visible parts are the complement of the
 //! union over triangles. A triangle on the edge (its own faces) cannot hide
 //! it and is skipped.
-use super::edges::{EdgeFacts, is_discontinuity};
+use super::edges::{EdgeFacts, EdgeTree, is_discontinuity};
 use super::space::Edge;
 use crate::path::Prim;
 use glam::DVec3;
 
-/// Most edge × triangle pairs the view is computed from; beyond, the warp
-/// keeps its shadow rays (a large mesh: the pairs would cost more than the
-/// rays they save on a short run).
+/// Most edge × triangle pairs the visible intervals are computed from;
+/// beyond, the warp keeps its shadow rays (a large mesh: the pairs would
+/// cost more than the rays they save on a short run).
 pub const MAX_PAIRS: usize = 20_000_000;
 
-/// The visible parts of the discontinuity edges seen from one point.
+/// Up to this many edges, a scan of the list beats the tree's node tests.
+pub const SCAN: usize = 64;
+
+/// What one point sees of the discontinuity edges.
 #[derive(Debug, Clone, Default)]
 pub struct SensorView {
     /// The point.
     pub point: DVec3,
-    /// The edges with a visible part, in index order.
+    /// The edges that can be discontinuities from the point (those with a
+    /// visible part, when the parts are known), scanned when there are at
+    /// most [`SCAN`].
     pub edges: Vec<u32>,
-    /// Per entry of `edges`, its visible intervals: `pieces[start[i]..start[i + 1]]`.
+    /// Their tree.
+    pub tree: EdgeTree,
+    /// Their visible parts, if computed.
+    pub visible: Option<Visible>,
+}
+
+/// The visible parts of some edges, as intervals of their parameter.
+#[derive(Debug, Clone, Default)]
+pub struct Visible {
+    /// Per edge of the scene, its entry in `start` (`u32::MAX`: none seen).
+    entry: Vec<u32>,
+    /// Per entry, its intervals: `pieces[start[i]..start[i + 1]]`.
     start: Vec<u32>,
     pieces: Vec<[f64; 2]>,
 }
 
 impl SensorView {
-    /// The view from `s` of the `edges` that are discontinuities from `s`,
-    /// occluded by the `opaque` triangles (with their primitive indices);
-    /// `None` when that needs more than [`MAX_PAIRS`] edge-triangle tests.
+    /// The view from `s` of the `edges` (with their `facts` and `weights`,
+    /// for the tree), occluded by the `opaque` triangles (with their
+    /// primitive indices); the intervals only below [`MAX_PAIRS`]
+    /// edge-triangle tests.
     pub fn new(
         s: DVec3,
         edges: &[Edge],
         facts: &[EdgeFacts],
+        weights: &[f64],
         opaque: &[(Prim, [DVec3; 3])],
-    ) -> Option<SensorView> {
+    ) -> SensorView {
         let seen: Vec<u32> = (0..edges.len() as u32)
             .filter(|&i| is_discontinuity(&edges[i as usize], &facts[i as usize], s))
             .collect();
-        if seen.len().saturating_mul(opaque.len()) > MAX_PAIRS {
-            return None;
-        }
-        let mut view = SensorView {
+        let visible = (seen.len().saturating_mul(opaque.len()) <= MAX_PAIRS)
+            .then(|| Visible::new(s, edges, &seen, opaque));
+        let seen: Vec<u32> = match &visible {
+            Some(v) => seen
+                .into_iter()
+                .filter(|&i| v.entry[i as usize] != u32::MAX)
+                .collect(),
+            None => seen,
+        };
+        SensorView {
             point: s,
-            edges: Vec::new(),
+            tree: EdgeTree::new(edges, facts, weights, seen.clone()),
+            edges: seen,
+            visible,
+        }
+    }
+}
+
+impl Visible {
+    fn new(s: DVec3, edges: &[Edge], seen: &[u32], opaque: &[(Prim, [DVec3; 3])]) -> Visible {
+        let mut v = Visible {
+            entry: vec![u32::MAX; edges.len()],
             start: vec![0],
             pieces: Vec::new(),
         };
         let mut hidden: Vec<[f64; 2]> = Vec::new();
-        for i in seen {
+        for &i in seen {
             let e = &edges[i as usize];
             hidden.clear();
             for (p, t) in opaque {
@@ -73,36 +110,45 @@ impl SensorView {
                 }
             }
             hidden.sort_by(|x, y| x[0].total_cmp(&y[0]));
-            let before = view.pieces.len();
+            let before = v.pieces.len();
             let mut from = 0.0;
             for h in &hidden {
                 if h[0] > from {
-                    view.pieces.push([from, h[0]]);
+                    v.pieces.push([from, h[0]]);
                 }
                 from = f64::max(from, h[1]);
             }
             if from < 1.0 {
-                view.pieces.push([from, 1.0]);
+                v.pieces.push([from, 1.0]);
             }
-            if view.pieces.len() > before {
-                view.edges.push(i);
-                view.start.push(view.pieces.len() as u32);
+            if v.pieces.len() > before {
+                v.entry[i as usize] = (v.start.len() - 1) as u32;
+                v.start.push(v.pieces.len() as u32);
             }
         }
-        Some(view)
+        v
     }
 
-    /// The visible intervals of the `k`-th edge of [`Self::edges`].
+    /// Whether the point at parameter `t` of edge `edge` is seen.
     #[inline]
-    pub fn pieces(&self, k: usize) -> &[[f64; 2]] {
-        &self.pieces[self.start[k] as usize..self.start[k + 1] as usize]
+    pub fn sees(&self, edge: u32, t: f64) -> bool {
+        let k = self.entry[edge as usize];
+        if k == u32::MAX {
+            return false;
+        }
+        self.pieces[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
+            .iter()
+            .any(|p| t >= p[0] && t <= p[1])
     }
 
-    /// Whether the point at parameter `t` of the `k`-th edge of
-    /// [`Self::edges`] is seen.
-    #[inline]
-    pub fn sees(&self, k: usize, t: f64) -> bool {
-        self.pieces(k).iter().any(|p| t >= p[0] && t <= p[1])
+    /// The visible intervals of edge `edge`.
+    #[cfg(test)]
+    fn pieces(&self, edge: u32) -> &[[f64; 2]] {
+        let k = self.entry[edge as usize];
+        if k == u32::MAX {
+            return &[];
+        }
+        &self.pieces[self.start[k as usize] as usize..self.start[k as usize + 1] as usize]
     }
 }
 
@@ -187,24 +233,24 @@ mod tests {
             edges.len()
         ];
         let s = DVec3::new(0.1, -0.2, -0.5);
-        let view = SensorView::new(s, &edges, &facts, &tris).unwrap();
+        let weights = vec![1.0; edges.len()];
+        let view = SensorView::new(s, &edges, &facts, &weights, &tris);
+        let view = view.visible.as_ref().unwrap();
         let (mut seen, mut hidden) = (0, 0);
         for (i, e) in edges.iter().enumerate() {
-            let k = view.edges.iter().position(|&j| j == i as u32);
             for step in 0..=200 {
                 let t = step as f64 / 200.0;
                 let q = e.a + (e.b - e.a) * t;
                 let rays = hidden_by_rays(s, q, &tris, e.faces);
                 // Off the intervals' ends, where rounding decides.
-                let near_end = k.is_some_and(|k| {
-                    view.pieces(k)
-                        .iter()
-                        .any(|p| (t - p[0]).abs() < 1e-9 || (t - p[1]).abs() < 1e-9)
-                });
+                let near_end = view
+                    .pieces(i as u32)
+                    .iter()
+                    .any(|p| (t - p[0]).abs() < 1e-9 || (t - p[1]).abs() < 1e-9);
                 if near_end {
                     continue;
                 }
-                let sees = k.is_some_and(|k| view.sees(k, t));
+                let sees = view.sees(i as u32, t);
                 assert_eq!(sees, !rays, "edge {i} at t = {t}");
                 if rays { hidden += 1 } else { seen += 1 }
             }

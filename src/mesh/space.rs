@@ -61,8 +61,8 @@ pub struct Space {
     pub(super) camera: Option<CameraFrame>,
     pixel_edges: OnceLock<PixelEdges>,
     /// What the sensor's point sees of the edges (built on first use, by
-    /// the expectation method; `None` for a scene too large for it).
-    sensor_view: OnceLock<Option<SensorView>>,
+    /// the expectation method).
+    sensor_view: OnceLock<SensorView>,
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
     pub(super) pole_rules: Vec<PoleRule>,
@@ -187,29 +187,27 @@ impl Space {
     }
 
     /// What the sensor's point (a probe's point, a camera's pinhole) sees
-    /// of the edges, built on first use; `None` when the scene is too large
-    /// for it ([`super::sensor_view::MAX_PAIRS`]).
+    /// of the edges, built on first use.
     #[inline]
-    pub(super) fn sensor_view(&self) -> Option<&SensorView> {
-        self.sensor_view
-            .get_or_init(|| {
-                let t = self.edge_tables();
-                let opaque: Vec<(Prim, [DVec3; 3])> = (0..self.tris.len())
-                    .filter(|&i| {
-                        self.scene.shapes()[self.owner[i] as usize]
-                            .surface
-                            .is_opaque()
-                    })
-                    .map(|i| (i as Prim, self.tris[i]))
-                    .collect();
-                SensorView::new(
-                    self.scene.sensor().point(),
-                    &t.edges,
-                    &t.edge_facts,
-                    &opaque,
-                )
-            })
-            .as_ref()
+    pub(super) fn sensor_view(&self) -> &SensorView {
+        self.sensor_view.get_or_init(|| {
+            let t = self.edge_tables();
+            let opaque: Vec<(Prim, [DVec3; 3])> = (0..self.tris.len())
+                .filter(|&i| {
+                    self.scene.shapes()[self.owner[i] as usize]
+                        .surface
+                        .is_opaque()
+                })
+                .map(|i| (i as Prim, self.tris[i]))
+                .collect();
+            SensorView::new(
+                self.scene.sensor().point(),
+                &t.edges,
+                &t.edge_facts,
+                &t.edge_weight,
+                &opaque,
+            )
+        })
     }
 
     /// The moving meshes' edges each camera pixel sees, built on first use

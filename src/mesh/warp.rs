@@ -274,8 +274,9 @@ impl Space {
 
     /// The visible edge crossings of the fibre nearest to θ on either side,
     /// within the knots `lo` and `hi` already found. At the sensor's point
-    /// the visible parts of the edges are known ([`SensorView`](super::sensor_view::SensorView)): no shadow
-    /// ray.
+    /// the search runs in the sensor's own edge tree, and where the visible
+    /// parts of the edges are known
+    /// ([`SensorView`](super::sensor_view::SensorView)) needs no shadow ray.
     #[allow(clippy::too_many_arguments)]
     fn nearest_crossings(
         &self,
@@ -288,21 +289,30 @@ impl Space {
         mut lo: FibreKnot,
         mut hi: FibreKnot,
     ) -> (FibreKnot, FibreKnot) {
-        let edges = &self.edge_tables().edges;
-        if skip == NO_PRIM
-            && let Some(view) = self.sensor_view().filter(|v| v.point == x)
-        {
-            for (k, &i) in view.edges.iter().enumerate() {
-                let Some((knot, t)) = crossing(&edges[i as usize], x, p, u, m) else {
-                    continue;
-                };
-                let cos = knot.cos;
-                if cos > cos_theta && cos < lo.cos && view.sees(k, t) {
-                    lo = knot;
+        let tables = self.edge_tables();
+        let edges = &tables.edges;
+        let (tree, list, visible) = match self.sensor_view() {
+            view if skip == NO_PRIM && view.point == x => (
+                &view.tree,
+                (view.edges.len() <= super::sensor_view::SCAN).then_some(&view.edges),
+                view.visible.as_ref(),
+            ),
+            _ => (&tables.all_edges, None, None),
+        };
+        if let Some(visible) = visible {
+            // The visible parts known: one scan, the nearest seen crossing
+            // on each side.
+            match list {
+                Some(list) => {
+                    for &i in list {
+                        let e = &edges[i as usize];
+                        nearer_seen(e, i, x, p, u, m, cos_theta, visible, &mut lo, &mut hi);
+                    }
                 }
-                if cos < cos_theta && cos > hi.cos && view.sees(k, t) {
-                    hi = knot;
-                }
+                None => tree.crossings(x, m, u, edges, &tables.edge_facts, |i| {
+                    let e = &edges[i as usize];
+                    nearer_seen(e, i, x, p, u, m, cos_theta, visible, &mut lo, &mut hi);
+                }),
             }
             return (lo, hi);
         }
@@ -315,25 +325,23 @@ impl Space {
         let (mut done_lo, mut done_hi) = (false, false);
         while !(done_lo && done_hi) {
             let (mut near_lo, mut near_hi) = (Nearest::new(), Nearest::new());
-            self.edge_tables().all_edges.crossings(
-                x,
-                m,
-                u,
-                edges,
-                &self.edge_tables().edge_facts,
-                |i| {
-                    let Some((knot, _)) = crossing(&edges[i as usize], x, p, u, m) else {
-                        return;
-                    };
-                    let cos = knot.cos;
-                    if !done_lo && cos > bound_lo && cos < lo.cos {
-                        near_lo.insert(cos, knot);
-                    }
-                    if !done_hi && cos < bound_hi && cos > hi.cos {
-                        near_hi.insert(-cos, knot);
-                    }
-                },
-            );
+            let mut candidate = |i: u32| {
+                let e = &edges[i as usize];
+                let Some((cos, _, q)) = cut(e, x, p, u, m) else {
+                    return;
+                };
+                let knot = crossing_knot(e, cos, q);
+                if !done_lo && cos > bound_lo && cos < lo.cos {
+                    near_lo.insert(cos, knot);
+                }
+                if !done_hi && cos < bound_hi && cos > hi.cos {
+                    near_hi.insert(-cos, knot);
+                }
+            };
+            match list {
+                Some(list) => list.iter().for_each(|&i| candidate(i)),
+                None => tree.crossings(x, m, u, edges, &tables.edge_facts, candidate),
+            }
             let settle = |done: &mut bool, near: &Nearest, bound: &mut f64, k: &mut FibreKnot| {
                 if *done {
                     return;
@@ -428,10 +436,10 @@ impl Space {
 }
 
 /// Where the plane through `x` of normal `m` crosses the edge `e` on the
-/// fibre's side (`u`), as a knot (its rates' fields left to fill) and the
-/// edge parameter there.
-#[inline]
-fn crossing(e: &Edge, x: DVec3, p: DVec3, u: DVec3, m: DVec3) -> Option<(FibreKnot, f64)> {
+/// fibre's side (`u`): the cosine of its polar angle from `p`, the edge
+/// parameter and the point.
+#[inline(always)]
+fn cut(e: &Edge, x: DVec3, p: DVec3, u: DVec3, m: DVec3) -> Option<(f64, f64, DVec3)> {
     let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
     if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
         return None;
@@ -443,8 +451,14 @@ fn crossing(e: &Edge, x: DVec3, p: DVec3, u: DVec3, m: DVec3) -> Option<(FibreKn
     if du <= 0.0 {
         return None; // the other half of the great circle
     }
-    let knot = FibreKnot {
-        cos: dp / d.length(),
+    Some((dp / d.length(), t, q))
+}
+
+/// The knot at a crossing of edge `e` (its rates' fields left to fill).
+#[inline(always)]
+fn crossing_knot(e: &Edge, cos: f64, q: DVec3) -> FibreKnot {
+    FibreKnot {
+        cos,
         edge: Some(Crossing {
             q,
             dir: e.b - e.a,
@@ -453,8 +467,34 @@ fn crossing(e: &Edge, x: DVec3, p: DVec3, u: DVec3, m: DVec3) -> Option<(FibreKn
             inv_r: 0.0,
             inv_across: 0.0,
         }),
+    }
+}
+
+/// One edge's crossing, if seen, as the nearer of it and the knots found
+/// so far on its side.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn nearer_seen(
+    e: &Edge,
+    i: u32,
+    x: DVec3,
+    p: DVec3,
+    u: DVec3,
+    m: DVec3,
+    cos_theta: f64,
+    visible: &super::sensor_view::Visible,
+    lo: &mut FibreKnot,
+    hi: &mut FibreKnot,
+) {
+    let Some((cos, t, q)) = cut(e, x, p, u, m) else {
+        return;
     };
-    Some((knot, t))
+    if cos > cos_theta && cos < lo.cos && visible.sees(i, t) {
+        *lo = crossing_knot(e, cos, q);
+    }
+    if cos < cos_theta && cos > hi.cos && visible.sees(i, t) {
+        *hi = crossing_knot(e, cos, q);
+    }
 }
 
 /// How many candidate knots a side keeps per scan.
