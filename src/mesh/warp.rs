@@ -286,18 +286,38 @@ impl Space {
         u: DVec3,
         m: DVec3,
         cos_theta: f64,
+        lo: FibreKnot,
+        hi: FibreKnot,
+    ) -> (FibreKnot, FibreKnot) {
+        let at_sensor = skip == NO_PRIM && self.sensor_view().point == x;
+        self.nearest_crossings_by(at_sensor, x, skip, p, u, m, cos_theta, lo, hi)
+    }
+
+    /// [`Self::nearest_crossings`], by the sensor's view or by shadow rays.
+    #[allow(clippy::too_many_arguments)]
+    fn nearest_crossings_by(
+        &self,
+        at_sensor: bool,
+        x: DVec3,
+        skip: u32,
+        p: DVec3,
+        u: DVec3,
+        m: DVec3,
+        cos_theta: f64,
         mut lo: FibreKnot,
         mut hi: FibreKnot,
     ) -> (FibreKnot, FibreKnot) {
         let tables = self.edge_tables();
         let edges = &tables.edges;
-        let (tree, list, visible) = match self.sensor_view() {
-            view if skip == NO_PRIM && view.point == x => (
+        let (tree, list, visible) = if at_sensor {
+            let view = self.sensor_view();
+            (
                 &view.tree,
                 (view.edges.len() <= super::sensor_view::SCAN).then_some(&view.edges),
                 view.visible.as_ref(),
-            ),
-            _ => (&tables.all_edges, None, None),
+            )
+        } else {
+            (&tables.all_edges, None, None)
         };
         if let Some(visible) = visible {
             // The visible parts known: one scan, the nearest seen crossing
@@ -555,5 +575,98 @@ impl Nearest {
     #[inline]
     fn full(&self) -> bool {
         self.dropped
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::scene::{Motion, Parameter, Scene, Surface};
+    use rand::{RngExt, SeedableRng};
+    use std::sync::Arc;
+
+    /// At the sensor, the knots found through the precomputed view are the
+    /// ones shadow rays find: a box partly hiding a square, both partly
+    /// hiding the lamp, random fibres (no two edges in a plane through the
+    /// sensor: there the two answers may differ by a rounding).
+    #[test]
+    fn the_sensor_view_finds_the_knots_shadow_rays_find() {
+        let cases = crate::mesh::cases::cube_shape;
+        let shapes = vec![
+            crate::mesh::cases::lamp(),
+            cases(
+                "box",
+                DVec3::new(0.13, 0.02, 1.1),
+                0.29,
+                Surface::Absorber,
+                None,
+            ),
+            crate::mesh::cases::square_shape(
+                "sq",
+                DVec3::new(-0.113, 0.071, 1.6),
+                0.337,
+                Surface::Absorber,
+            ),
+        ];
+        let parameters = vec![Parameter {
+            name: "box_tx".into(),
+            shape: "box".into(),
+            motion: Motion::TranslateX,
+        }];
+        let scene = Scene::new(shapes, parameters, crate::mesh::cases::up()).unwrap();
+        let space = Space::new(Arc::new(scene));
+        let x = space.scene().sensor().point();
+        assert!(space.sensor_view().visible.is_some());
+        let mut rng = crate::rng::PathRng::seed_from_u64(11);
+        let mut unit = || {
+            let z: f64 = 2.0 * rng.random::<f64>() - 1.0;
+            let phi = 2.0 * PI * rng.random::<f64>();
+            let s = (1.0 - z * z).sqrt();
+            DVec3::new(s * phi.cos(), s * phi.sin(), z)
+        };
+        let still = |cos: f64| FibreKnot { cos, edge: None };
+        let (mut edges_found, mut hidden_seen) = (0, 0);
+        for _ in 0..20_000 {
+            let (p, mut w) = (unit(), unit());
+            w.z = w.z.abs(); // up, where the lamp and the meshes are
+            let c = w.dot(p);
+            let perp = w - p * c;
+            let u = perp / perp.length();
+            let m = p.cross(u);
+            let by_view =
+                space.nearest_crossings_by(true, x, NO_PRIM, p, u, m, c, still(1.0), still(-1.0));
+            let by_rays =
+                space.nearest_crossings_by(false, x, NO_PRIM, p, u, m, c, still(1.0), still(-1.0));
+            // The same knot, or (at a mesh corner, where two edges cross
+            // the plane a rounding apart) one as near.
+            for (a, b) in [(by_view.0, by_rays.0), (by_view.1, by_rays.1)] {
+                assert!(
+                    (a.cos - b.cos).abs() < 1e-12,
+                    "knot along {w} from pole {p}"
+                );
+                let (qa, qb) = (a.edge.map(|e| e.q), b.edge.map(|e| e.q));
+                assert!(
+                    qa.zip(qb).map_or(qa.is_none() && qb.is_none(), |(qa, qb)| {
+                        (qa - qb).length() < 1e-9
+                    }),
+                    "knot along {w} from pole {p}: {qa:?} {qb:?}"
+                );
+                edges_found += a.edge.is_some() as u32;
+            }
+            // Some fibres pass a crossing nearer than the knot that is no
+            // knot (hidden, or on an edge that is no silhouette).
+            let nearest_any = space
+                .edges()
+                .iter()
+                .filter_map(|e| cut(e, x, p, u, m))
+                .filter(|&(cos, _, _)| cos > c)
+                .map(|(cos, _, _)| cos)
+                .fold(f64::INFINITY, f64::min);
+            if nearest_any < by_view.0.cos {
+                hidden_seen += 1;
+            }
+        }
+        assert!(edges_found > 2000, "{edges_found}");
+        assert!(hidden_seen > 100, "{hidden_seen}");
     }
 }
