@@ -17,8 +17,10 @@
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Rendering" and "Corner jumps".
 use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
-use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, surface_radiance};
-use super::{Boundaries, Geometry, Hit, Lobe, NO_PRIM, Side, Vector};
+use super::walk::{
+    Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance,
+};
+use super::{Boundaries, Geometry, Hit, Lobe, NO_PRIM, Side, Surface, Vector};
 use crate::rng::PathRng;
 use rand::RngExt;
 
@@ -193,14 +195,23 @@ pub(super) fn corner_jump<G: Boundaries>(
         Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(&b, p), p, wq, medium),
         Side::Past => radiance(g, rng, b.q, wq, medium, NO_PRIM),
     };
-    // Common random numbers for the two sides: where both see a surface
-    // (a reflector's corner between two faces) their difference is small
-    // and so is its variance.
-    let mut twin = rng.clone();
-    let l_ahead = side(rng, ahead);
-    let l_behind = side(&mut twin, behind);
+    let reflector = |s: Side| match s {
+        Side::Surface(p) => matches!(g.surface(p), Surface::Reflector { .. }).then_some(p),
+        Side::Past => None,
+    };
+    let jump = if let (Some(pa), Some(pb)) = (reflector(ahead), reflector(behind)) {
+        // Two faces of a reflector: their radiances from shared draws.
+        let (ya, yb) = (g.off_boundary(&b, pa), g.off_boundary(&b, pb));
+        reflected_jump(g, rng, (ya, pa), (yb, pb), wq, medium)
+    } else {
+        // Common random numbers for the two sides.
+        let mut twin = rng.clone();
+        let l_ahead = side(rng, ahead);
+        let l_behind = side(&mut twin, behind);
+        l_behind - l_ahead
+    };
     // d/dπ ∫ f L dη ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
-    let term = v.beta * f * t * (l_behind - l_ahead) * b.inv_pdf;
+    let term = v.beta * f * t * jump * b.inv_pdf;
     for j in involved.iter() {
         let s = &mut d.slots[j];
         s.add_boundary(term * s.tb_dot, (term * s.tb_dot).abs());
