@@ -10,16 +10,16 @@
 //!   corner seen from the vertex): `f(η_q) T(x, q) [L_behind(q) − L_ahead(q)]
 //!   v_n`, `v_n` the discontinuity's velocity relative to the frame, one
 //!   discontinuity drawn at random and each side's radiance from one nested
-//!   path evaluated exactly at it (double randomisation);
+//!   path evaluated exactly at it (double randomisation); between two faces
+//!   of a reflector, both sides from shared draws and one path
+//!   ([`reflected_jump`]);
 //! - next-event estimation: the connection's direction turns with the frame
 //!   like any other.
 //!
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Rendering" and "Corner jumps".
 use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
-use super::walk::{
-    Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance,
-};
+use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance};
 use super::{Boundaries, Geometry, Hit, Lobe, NO_PRIM, Side, Surface, Vector};
 use crate::rng::PathRng;
 use rand::RngExt;
