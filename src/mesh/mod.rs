@@ -8,7 +8,7 @@
 //! - [`bvh`]: ray casting through obvhs, every hit re-tested in f64;
 //! - [`space`]: the scene behind the path core's `Geometry`; [`lobe`]: the
 //!   3D lobes; [`boundaries`]: the edges behind `Boundaries`; [`warp`]: the
-//!   expectation method's fibre warp; [`sensor_view`]: what the sensor's
+//!   expectation method's fibre warp, [`knots`] its knot search; [`sensor_view`]: what the sensor's
 //!   point sees of every edge (the warp's knots there without shadow rays);
 //! - [`camera`]: the pinhole camera (pixels as lobes, the edges each
 //!   pixel sees);
@@ -24,6 +24,7 @@ pub mod exact;
 #[cfg(feature = "figures")]
 pub mod figures;
 pub mod file;
+pub mod knots;
 pub mod lobe;
 pub mod methods;
 pub mod scene;

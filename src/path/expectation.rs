@@ -30,7 +30,7 @@ pub struct Expectation<'a, G: Geometry> {
     /// The walk's state.
     pub d: Deform<G::V>,
     /// A direction drawn in vacuum whose warp waits for its ray's hit: a
-    /// path that then ends without light skips it (see [`dead_end`]).
+    /// path that then ends without light skips it (see `dead_end`).
     pub pending: Option<(Vertex<G>, G::V)>,
 }
 
