@@ -171,56 +171,73 @@ fn reflector_matches_finite_differences() {
     against_finite_differences("reflector.toml", 400_000, 2_000_000);
 }
 
+/// A lamp segment from `lamp.0` to `lamp.1` over one open reflecting
+/// polyline `shape` (albedo `albedo`) that `motions` move, seen by an
+/// irradiance sensor at `point` facing `normal`.
+fn lamp_over_reflector(
+    lamp: [[f64; 2]; 2],
+    (name, vertices, albedo): (&str, Vec<[f64; 2]>, f64),
+    motions: Vec<(&str, geosens::flat::Motion)>,
+    (point, normal): ([f64; 2], [f64; 2]),
+) -> Arc<Scene> {
+    use geosens::flat::{Parameter, Sensor, Shape, Surface};
+    use glam::DVec2;
+    let v = |p: [f64; 2]| DVec2::new(p[0], p[1]);
+    let shape = |name: &str, vertices: Vec<[f64; 2]>, surface| Shape {
+        name: name.into(),
+        vertices: vertices.into_iter().map(v).collect(),
+        closed: false,
+        surface,
+        medium: None,
+    };
+    let shapes = vec![
+        shape("lamp", lamp.to_vec(), Surface::Emitter { radiance: 1.0 }),
+        shape(name, vertices, Surface::Reflector { albedo }),
+    ];
+    let parameters = motions
+        .into_iter()
+        .map(|(p, motion)| Parameter {
+            name: p.into(),
+            shape: name.into(),
+            motion,
+        })
+        .collect();
+    let sensor = Sensor::Irradiance {
+        point: v(point),
+        normal: v(normal).normalize(),
+    };
+    Arc::new(Scene::new(shapes, parameters, sensor).unwrap())
+}
+
 #[test]
 fn a_wavy_reflector_matches_finite_differences() {
     // A floor of 24 reflecting segments under a lamp, seen from above: every
-    // corner between two of its faces, convex or concave, is a jump between
-    // two reflector faces (`walk::reflected_jump`) seen from the sensor and
-    // from the floor itself; moved up and turned.
-    use geosens::flat::{Motion, Parameter, Sensor, Shape, Surface};
-    use glam::DVec2;
-    let floor = Shape {
-        name: "floor".into(),
-        vertices: (0..=24)
-            .map(|i| {
-                let x = -2.0 + 4.0 * i as f64 / 24.0;
-                DVec2::new(x, 0.08 * (7.0 * x).sin() + 0.03 * x)
-            })
-            .collect(),
-        closed: false,
-        surface: Surface::Reflector { albedo: 0.8 },
-        medium: None,
-    };
-    let lamp = Shape {
-        name: "lamp".into(),
-        vertices: vec![DVec2::new(-1.0, 2.0), DVec2::new(0.7, 2.1)],
-        closed: false,
-        surface: Surface::Emitter { radiance: 1.0 },
-        medium: None,
-    };
-    let parameter = |name: &str, motion| Parameter {
-        name: name.into(),
-        shape: "floor".into(),
-        motion,
-    };
-    let scene = Scene::new(
-        vec![lamp, floor],
+    // corner between two of its faces, convex or concave, turns under
+    // `rendering::SHARED_TURN` and is a jump between two reflector faces
+    // drawn from shared draws (`walk::reflected_jump`), seen from the sensor
+    // and from the floor itself; moved up and turned.
+    use geosens::flat::Motion;
+    let floor = (0..=24)
+        .map(|i| {
+            let x = -2.0 + 4.0 * i as f64 / 24.0;
+            [x, 0.08 * (7.0 * x).sin() + 0.03 * x]
+        })
+        .collect();
+    let scene = lamp_over_reflector(
+        [[-1.0, 2.0], [0.7, 2.1]],
+        ("floor", floor, 0.8),
         vec![
-            parameter("floor_ty", Motion::TranslateY),
-            parameter(
+            ("floor_ty", Motion::TranslateY),
+            (
                 "floor_rot",
                 Motion::Rotate {
-                    pivot: Some(DVec2::new(0.3, 0.0)),
+                    pivot: Some(glam::DVec2::new(0.3, 0.0)),
                 },
             ),
         ],
-        Sensor::Irradiance {
-            point: DVec2::new(0.1, 0.6),
-            normal: -DVec2::Y,
-        },
-    )
-    .unwrap();
-    scene_against_finite_differences("wavy floor", &Arc::new(scene), 400_000, 2_000_000);
+        ([0.1, 0.6], [0.0, -1.0]),
+    );
+    scene_against_finite_differences("wavy floor", &scene, 400_000, 2_000_000);
 }
 
 #[test]
@@ -231,49 +248,22 @@ fn a_reflecting_ridge_between_light_and_shade_matches_finite_differences() {
     // translation's derivative is mostly the jump across the ridge between
     // two reflector faces (`walk::reflected_jump`), and its rotation's too
     // in part.
-    use geosens::flat::{Motion, Parameter, Sensor, Shape, Surface};
-    use glam::DVec2;
-    let tent = Shape {
-        name: "tent".into(),
-        vertices: vec![
-            DVec2::new(-1.0, 0.0),
-            DVec2::new(0.05, 0.28),
-            DVec2::new(1.1, 0.0),
-        ],
-        closed: false,
-        surface: Surface::Reflector { albedo: 0.7 },
-        medium: None,
-    };
-    let lamp = Shape {
-        name: "lamp".into(),
-        vertices: vec![DVec2::new(-3.0, 0.3), DVec2::new(-2.6, 0.9)],
-        closed: false,
-        surface: Surface::Emitter { radiance: 1.0 },
-        medium: None,
-    };
-    let parameter = |name: &str, motion| Parameter {
-        name: name.into(),
-        shape: "tent".into(),
-        motion,
-    };
-    let scene = Scene::new(
-        vec![lamp, tent],
+    use geosens::flat::Motion;
+    let scene = lamp_over_reflector(
+        [[-3.0, 0.3], [-2.6, 0.9]],
+        ("tent", vec![[-1.0, 0.0], [0.05, 0.28], [1.1, 0.0]], 0.7),
         vec![
-            parameter("tent_tx", Motion::TranslateX),
-            parameter(
+            ("tent_tx", Motion::TranslateX),
+            (
                 "tent_rot",
                 Motion::Rotate {
-                    pivot: Some(DVec2::new(0.2, 0.1)),
+                    pivot: Some(glam::DVec2::new(0.2, 0.1)),
                 },
             ),
         ],
-        Sensor::Irradiance {
-            point: DVec2::new(0.25, 1.4),
-            normal: -DVec2::Y,
-        },
-    )
-    .unwrap();
-    scene_against_finite_differences("ridge", &Arc::new(scene), 400_000, 2_000_000);
+        ([0.25, 1.4], [0.0, -1.0]),
+    );
+    scene_against_finite_differences("ridge", &scene, 400_000, 2_000_000);
 }
 
 #[test]
@@ -284,44 +274,17 @@ fn a_reflecting_corner_lit_through_itself_matches_finite_differences() {
     // wall gathers from the floor. The faces turn 125°, past
     // `rendering::SHARED_TURN`: two nested paths with common random numbers
     // (with shared draws rendering's variance here was four times larger).
-    use geosens::flat::{Motion, Parameter, Sensor, Shape, Surface};
-    use glam::DVec2;
-    let corner = Shape {
-        name: "corner".into(),
-        vertices: vec![
-            DVec2::new(-0.3, 1.0),
-            DVec2::new(-1.0, 0.0),
-            DVec2::new(1.6, 0.05),
-        ],
-        closed: false,
-        surface: Surface::Reflector { albedo: 0.9 },
-        medium: None,
-    };
-    let lamp = Shape {
-        name: "lamp".into(),
-        vertices: vec![DVec2::new(-0.4, 2.5), DVec2::new(0.6, 2.6)],
-        closed: false,
-        surface: Surface::Emitter { radiance: 1.0 },
-        medium: None,
-    };
-    let parameter = |name: &str, motion| Parameter {
-        name: name.into(),
-        shape: "corner".into(),
-        motion,
-    };
-    let scene = Scene::new(
-        vec![lamp, corner],
+    use geosens::flat::Motion;
+    let scene = lamp_over_reflector(
+        [[-0.4, 2.5], [0.6, 2.6]],
+        ("corner", vec![[-0.3, 1.0], [-1.0, 0.0], [1.6, 0.05]], 0.9),
         vec![
-            parameter("corner_tx", Motion::TranslateX),
-            parameter("corner_ty", Motion::TranslateY),
+            ("corner_tx", Motion::TranslateX),
+            ("corner_ty", Motion::TranslateY),
         ],
-        Sensor::Irradiance {
-            point: DVec2::new(0.3, 0.35),
-            normal: DVec2::new(-1.0, -0.2).normalize(),
-        },
-    )
-    .unwrap();
-    scene_against_finite_differences("corner", &Arc::new(scene), 400_000, 2_000_000);
+        ([0.3, 0.35], [-1.0, -0.2]),
+    );
+    scene_against_finite_differences("corner", &scene, 400_000, 2_000_000);
 }
 
 #[test]
