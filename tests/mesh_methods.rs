@@ -701,3 +701,62 @@ fn a_reflecting_room_matches_finite_differences() {
         }
     }
 }
+
+/// A folded reflecting sheet whose faces turn 30° at the crease (under
+/// `rendering::SHARED_TURN`), lit from low on one side: one face bright,
+/// the other in its own shade, so the jump across the crease (two
+/// reflector faces, `walk::reflected_jump`'s shared draws) carries most of
+/// the translation's derivative; against finite differences.
+#[test]
+fn a_folded_reflector_between_light_and_shade_matches_finite_differences() {
+    let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let sheet = Shape {
+        name: "sheet".into(),
+        vertices: vec![
+            v(-1.0, -1.0, 0.0),
+            v(0.05, -1.0, 0.28),
+            v(1.1, -1.0, 0.0),
+            v(-1.0, 1.0, 0.0),
+            v(0.05, 1.0, 0.28),
+            v(1.1, 1.0, 0.0),
+        ],
+        triangles: vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]],
+        surface: Surface::Reflector { albedo: 0.7 },
+        medium: None,
+    };
+    let low_lamp = Shape {
+        name: "lamp".into(),
+        vertices: vec![
+            v(-3.0, -1.0, 0.1),
+            v(-3.0, 1.0, 0.1),
+            v(-2.6, 1.0, 0.9),
+            v(-2.6, -1.0, 0.9),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        surface: Surface::Emitter { radiance: 1.0 },
+        medium: None,
+    };
+    let motions = [
+        ("sheet_tx", Motion::TranslateX),
+        (
+            "sheet_rot",
+            Motion::Rotate {
+                axis: DVec3::Y,
+                pivot: Some(v(0.2, 0.0, 0.1)),
+            },
+        ),
+    ];
+    let sensor = Sensor::Irradiance {
+        point: v(0.25, 0.1, 1.4),
+        normal: -DVec3::Z,
+    };
+    let scene =
+        Arc::new(Scene::new(vec![low_lamp, sheet], params("sheet", &motions), sensor).unwrap());
+    let fd = estimate(&scene, Method::Fd, 2_000_000, 11);
+    for m in [Method::Rendering, Method::Transport, Method::Expectation] {
+        let r = estimate(&scene, m, 400_000, 5);
+        for (name, _) in motions {
+            against_fd(m, name, &r, &fd);
+        }
+    }
+}
