@@ -193,6 +193,18 @@ impl Space {
     fn lamp_behind(&self, x: DVec3, edge: &Edge) -> bool {
         let (ra, rb) = (edge.a - x, edge.b - x);
         let n = ra.cross(rb);
+        // First whether the plane cuts a lamp at all (most planes miss).
+        let cut = |tri: &[DVec3; 3]| {
+            let h = tri.map(|v| (v - x).dot(n) > 0.0);
+            h[0] != h[1] || h[1] != h[2]
+        };
+        if !self
+            .emitters
+            .iter()
+            .any(|&(p, _)| cut(&self.tris[p as usize]))
+        {
+            return false;
+        }
         let (ta, tb) = (n.cross(ra), rb.cross(n));
         self.emitters
             .iter()
@@ -291,8 +303,10 @@ impl Space {
                 continue;
             }
             if let Some(parts) = EdgeArc::new(edge, x).and_then(|a| self.lamp_intervals(x, &a)) {
-                overlap[k] = parts.total;
-                total += parts.total;
+                let r = (0.5 * (edge.a + edge.b) - x).length();
+                let w = parts.total / r;
+                overlap[k] = w;
+                total += w;
             }
         }
         (overlap, total)
