@@ -5,14 +5,28 @@
 //! crease (each side sees another face: a jump for a reflector only).
 //!
 //! The boundary term of the directional integral is a line integral along
-//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`. An edge is drawn from the
-//! edge hierarchy ([`super::edges`]: by weight, length × dihedral turn / π,
-//! among the edges that can be discontinuities from `x`), a point in angle
-//! along its arc (the same uniform number, rescaled): half the time
-//! uniformly, half the time on the parts of the arc behind which a lamp
-//! lies; the inverse of the mixture's density per unit arc length goes into
-//! the boundary point, so the path core's corner term
-//! (`rendering::corner_jump`) is, unchanged, the edge term.
+//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`, estimated by one point
+//! drawn from a defensive mixture of two strategies:
+//!
+//! - the edge hierarchy's ([`super::edges`]): an edge by weight, length ×
+//!   dihedral turn / π, among those that can be discontinuities from `x`,
+//!   then a point in angle along its arc (the same uniform number,
+//!   rescaled), half the time uniformly, half on the parts of the arc
+//!   behind which a lamp lies;
+//! - by lamp overlap (half the draws, when the hierarchy holds at most
+//!   `LAMP_EDGES` (64) edges and some silhouette from `x` has a lamp behind
+//!   part of its arc): an edge in proportion to the angle of those parts
+//!   over its distance, a point uniform on them. The hierarchy draws an
+//!   edge without a lamp behind as often as one with: where the jump
+//!   carries direct light those draws are wasted.
+//!
+//! The density of the point, per unit arc length, is the mixture's at that
+//! point whichever strategy drew it: `(1 − s) p_tree(e) p(α | e) + s
+//! p_lamp(e) p_lamp(α | e)`, the tree's probability of an edge the lamp
+//! strategy drew from `EdgeTree::probability` (the same
+//! descent, to the last bit); its inverse goes into the boundary point, so
+//! the path core's corner term (`rendering::corner_jump`) is, unchanged,
+//! the edge term.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
 use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
@@ -278,10 +292,12 @@ impl Space {
         })
     }
 
-    /// Per edge of `tree` (in its order), the length of its arc seen from
-    /// `x` with a lamp behind (0 unless it is a silhouette from `x`: a
-    /// crease whose faces both face `x`, or both away, shows no lamp past
-    /// it, whatever lies behind its arc),
+    /// Per edge of `tree` (in its order), the weight the lamp strategy
+    /// draws it with: the angle of its arc seen from `x` with a lamp behind
+    /// over the distance to its midpoint (the arc's normal speed goes as
+    /// 1/distance), 0 unless it is a silhouette from `x` (a crease whose
+    /// faces both face `x`, or both away, shows no lamp past it, whatever
+    /// lies behind its arc),
     /// and their total; all 0 when the tree holds more than [`LAMP_EDGES`]
     /// edges or the lamps more than [`LAMP_TRIANGLES`] triangles.
     #[inline]
@@ -322,9 +338,16 @@ impl Space {
     ///   its arc, half the time uniform in angle and half on the parts of
     ///   the arc behind which a lamp lies;
     /// - by lamp overlap (share [`LAMP_SHARE`], when the tree holds at
-    ///   most [`LAMP_EDGES`] edges and some arc has a lamp behind): an edge
-    ///   in proportion to the length of its arc with a lamp behind, a point
+    ///   most [`LAMP_EDGES`] edges and some silhouette's arc has a lamp
+    ///   behind): an edge in proportion to the angle of its arc with a
+    ///   lamp behind over its distance ([`Space::lamp_overlaps`]), a point
     ///   uniform on those parts.
+    ///
+    /// Any rule for the lamp strategy's weights keeps the estimate
+    /// unbiased, so long as the density reported is that of the draws:
+    /// every term is evaluated from the same `(x, edge)` by the same
+    /// functions on both paths, and the tree's half keeps a floor on every
+    /// point of every discontinuity.
     #[inline]
     fn edge_point(&self, x: DVec3, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
         let tables = self.edge_tables();
@@ -402,7 +425,7 @@ impl Space {
         let d = edge.b - edge.a;
         let tau = (-(arc.ra.cross(w).dot(arc.n)) / d.cross(w).dot(arc.n)).clamp(0.0, 1.0);
         let q = edge.a + d * tau;
-        if !q.is_finite() || !(density > 0.0) {
+        if !q.is_finite() || density.is_nan() || density <= 0.0 {
             return None;
         }
         Some(BoundaryPoint {
