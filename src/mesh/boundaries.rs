@@ -405,8 +405,15 @@ impl Space {
             Some(ref l) => {
                 let cover = l.cover(alpha);
                 // The edge's share of the draws by lamp overlap (0 if the
-                // cheap test left it out), then its point's density.
-                let o = tree.place(index).map_or(0.0, |k| overlap[k]);
+                // cheap test left it out, or the tree is too large for
+                // them), then its point's density.
+                let o = if share > 0.0 {
+                    tree.place(index)
+                        .and_then(|k| overlap.get(k).copied())
+                        .unwrap_or(0.0)
+                } else {
+                    0.0
+                };
                 (
                     p_tree * (0.5 / arc.arc + 0.5 * cover / l.total),
                     if o > 0.0 {
