@@ -65,7 +65,7 @@ const LAMP_TRIANGLES: usize = 16;
 /// Most edges in a tree for which the edge itself is also drawn by the
 /// length of its arc with a lamp behind (every edge's arc and lamp parts
 /// per draw); larger trees draw by the tree alone.
-const LAMP_EDGES: usize = 64;
+pub(super) const LAMP_EDGES: usize = 64;
 
 /// The share of the draws by lamp overlap at a vertex where some edge has
 /// a lamp behind part of its arc.
@@ -358,7 +358,13 @@ impl Space {
             &tables.moving_edges
         };
         let ids = tree.edges();
-        let (overlap, lamp_total) = self.lamp_overlaps(x, tree);
+        // At the sensor's point (a probe's every path starts there) the
+        // lamp weights are computed once per tree.
+        let (overlap, lamp_total) = if x == self.scene.sensor().point() {
+            *self.sensor_lamps[all as usize].get_or_init(|| self.lamp_overlaps(x, tree))
+        } else {
+            self.lamp_overlaps(x, tree)
+        };
         let share = if lamp_total > 0.0 { LAMP_SHARE } else { 0.0 };
         let (index, p_tree, arc, lamps, alpha) = if u < share {
             // By lamp overlap: the edge, then a point on its lamp parts.
