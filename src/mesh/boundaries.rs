@@ -5,16 +5,32 @@
 //! crease (each side sees another face: a jump for a reflector only).
 //!
 //! The boundary term of the directional integral is a line integral along
-//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`. An edge is drawn from the
-//! edge hierarchy ([`super::edges`]: by weight, length × dihedral turn / π,
-//! among the edges that can be discontinuities from `x`), a point in angle
-//! along its arc (the same uniform number, rescaled): half the time
-//! uniformly, half the time on the parts of the arc behind which a lamp
-//! lies; the inverse of the mixture's density per unit arc length goes into
-//! the boundary point, so the path core's corner term
-//! (`rendering::corner_jump`) is, unchanged, the edge term.
+//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`, estimated by one point
+//! drawn from a defensive mixture of two strategies:
+//!
+//! - the edge hierarchy's ([`super::edges`]): an edge by weight, length ×
+//!   dihedral turn / π, among those that can be discontinuities from `x`,
+//!   then a point in angle along its arc (the same uniform number,
+//!   rescaled), half the time uniformly, half on the parts of the arc
+//!   behind which a lamp lies;
+//! - by lamp overlap (half the draws, when the hierarchy holds at most
+//!   `LAMP_EDGES` (64) edges and some silhouette from `x` has a lamp behind
+//!   part of its arc): an edge in proportion to the angle of those parts
+//!   over its distance, a point uniform on them. The hierarchy draws an
+//!   edge without a lamp behind as often as one with: where the jump
+//!   carries direct light those draws are wasted.
+//!
+//! The density of the point, per unit arc length, is the mixture's at that
+//! point whichever strategy drew it: `(1 − s) p_tree(e) p(α | e) + s
+//! p_lamp(e) p_lamp(α | e)`, the tree's probability of an edge the lamp
+//! strategy drew from `EdgeTree::probability` (the same
+//! descent, to the last bit); its inverse goes into the boundary point, so
+//! the path core's corner term (`rendering::corner_jump`) is, unchanged,
+//! the edge term.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
+use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
+use super::space::Edge;
 use super::space::Space;
 use super::warp::SpaceWarp;
 use crate::path::walk::Vertex;
@@ -46,55 +62,198 @@ impl Space {
 /// lamp lies behind them (a test per emitter triangle per draw).
 const LAMP_TRIANGLES: usize = 16;
 
+/// Most edges in a tree for which the edge itself is also drawn by the
+/// length of its arc with a lamp behind (every edge's arc and lamp parts
+/// per draw); larger trees draw by the tree alone.
+pub(super) const LAMP_EDGES: usize = 64;
+
+/// The share of the draws by lamp overlap at a vertex where some edge has
+/// a lamp behind part of its arc.
+const LAMP_SHARE: f64 = 0.5;
+
+/// An edge's arc seen from `x`: the directions `wa cos α + t sin α`,
+/// `α ∈ [0, arc]`, in the plane through `x` and the edge (unit normal `n`).
+#[derive(Debug, Clone, Copy)]
+struct EdgeArc {
+    /// From `x` to the edge's ends.
+    ra: DVec3,
+    rb: DVec3,
+    n: DVec3,
+    wa: DVec3,
+    t: DVec3,
+    arc: f64,
+}
+
+impl EdgeArc {
+    /// The arc of `edge` seen from `x`; `None` seen end-on.
+    #[inline]
+    fn new(edge: &Edge, x: DVec3) -> Option<EdgeArc> {
+        let (ra, rb) = (edge.a - x, edge.b - x);
+        let n = ra.cross(rb);
+        let (sin_g, cos_g) = (n.length(), ra.dot(rb));
+        let arc = sin_g.atan2(cos_g);
+        if arc.is_nan() || arc <= 0.0 || sin_g == 0.0 {
+            return None; // seen end-on: no arc
+        }
+        let n = n / sin_g;
+        let wa = ra.normalize();
+        Some(EdgeArc {
+            ra,
+            rb,
+            n,
+            wa,
+            t: n.cross(wa),
+            arc,
+        })
+    }
+}
+
+/// The parts of an arc behind which a lamp lies: intervals of `α` (one per
+/// emitter triangle the arc's plane cuts; they may overlap) and their
+/// total length.
+#[derive(Debug, Clone, Copy)]
+struct LampParts {
+    intervals: [(f64, f64); LAMP_TRIANGLES],
+    count: usize,
+    total: f64,
+}
+
+impl LampParts {
+    /// An angle uniform over the parts (an interval by its length, then
+    /// uniform in it) for `v ∈ [0, 1)`; its density per unit angle is
+    /// [`LampParts::cover`] over `total`.
+    #[inline]
+    fn pick(&self, v: f64, arc: f64) -> f64 {
+        let mut left = v * self.total;
+        let mut pick = self.intervals[self.count - 1];
+        for iv in &self.intervals[..self.count] {
+            let len = iv.1 - iv.0;
+            if left < len {
+                pick = *iv;
+                break;
+            }
+            left -= len;
+        }
+        (pick.0 + left.min(pick.1 - pick.0)).clamp(0.0, arc)
+    }
+
+    /// How many of the intervals hold `alpha`.
+    #[inline]
+    fn cover(&self, alpha: f64) -> f64 {
+        self.intervals[..self.count]
+            .iter()
+            .filter(|iv| iv.0 <= alpha && alpha <= iv.1)
+            .count() as f64
+    }
+}
+
+/// Whether `edge` is a silhouette seen from `x`: open, or its faces facing
+/// `x` differently (a reflector's crease, a discontinuity from everywhere
+/// for the edge tree, is not one unless it is so).
+#[inline]
+fn is_silhouette(edge: &Edge, facts: &EdgeFacts, x: DVec3) -> bool {
+    if edge.faces[1] == NO_PRIM {
+        return true;
+    }
+    let r = x - edge.a;
+    let (s0, s1) = (facts.normals[0].dot(r), facts.normals[1].dot(r));
+    (s0 > 0.0) != (s1 > 0.0)
+}
+
+/// The part of the segment where the plane through `x` of normal `n` (any
+/// length) cuts the triangle `tri` that is seen from `x` inside the wedge
+/// between two directions `ra`, `rb` of that plane (less than π apart):
+/// where `r·ta ≥ 0` (`ta = n × ra`: on `rb`'s side of `ra`) and `r·tb ≥ 0`
+/// (`tb = rb × n`: on `ra`'s side of `rb`), both linear along the segment.
+/// Its ends relative to `x`, or `None`.
+#[inline]
+fn wedge_cut(tri: &[DVec3; 3], x: DVec3, n: DVec3, ta: DVec3, tb: DVec3) -> Option<[DVec3; 2]> {
+    let h = tri.map(|v| (v - x).dot(n));
+    let mut ends = [DVec3::ZERO; 2];
+    let mut k = 0;
+    for i in 0..3 {
+        let (i0, i1) = (i, (i + 1) % 3);
+        if (h[i0] > 0.0) != (h[i1] > 0.0) && k < 2 {
+            let s = h[i0] / (h[i0] - h[i1]);
+            ends[k] = tri[i0] + (tri[i1] - tri[i0]) * s - x;
+            k += 1;
+        }
+    }
+    if k < 2 {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for m in [ta, tb] {
+        let (f0, f1) = (ends[0].dot(m), ends[1].dot(m));
+        if f0 < 0.0 && f1 < 0.0 {
+            return None;
+        }
+        if f0 < 0.0 {
+            lo = lo.max(f0 / (f0 - f1));
+        } else if f1 < 0.0 {
+            hi = hi.min(f0 / (f0 - f1));
+        }
+    }
+    let d = ends[1] - ends[0];
+    (hi > lo).then(|| [ends[0] + d * lo, ends[0] + d * hi])
+}
+
 impl Space {
-    /// The parts of an edge's arc seen from `x` (in the plane of unit normal
-    /// `n`, angles `α ∈ [0, arc]` from `wa` toward `t`) behind which an
-    /// emitter triangle lies: per triangle, the angles of the segment where
-    /// the plane cuts it, clipped to the arc. `None` without such parts, or
-    /// with more than [`LAMP_TRIANGLES`] emitter triangles.
-    #[allow(clippy::type_complexity)]
-    fn lamp_intervals(
-        &self,
-        x: DVec3,
-        n: DVec3,
-        wa: DVec3,
-        t: DVec3,
-        arc: f64,
-    ) -> Option<([(f64, f64); LAMP_TRIANGLES], usize, f64)> {
+    /// Whether a lamp (an emitter triangle) lies behind some of the arc of
+    /// `edge` seen from `x`: [`wedge_cut`] per emitter triangle, in raw
+    /// vectors (no square root, no angle), the cheap test before
+    /// [`Space::lamp_intervals`].
+    #[inline]
+    fn lamp_behind(&self, x: DVec3, edge: &Edge) -> bool {
+        let (ra, rb) = (edge.a - x, edge.b - x);
+        let n = ra.cross(rb);
+        // First whether the plane cuts a lamp at all (most planes miss).
+        let cut = |tri: &[DVec3; 3]| {
+            let h = tri.map(|v| (v - x).dot(n) > 0.0);
+            h[0] != h[1] || h[1] != h[2]
+        };
+        if !self
+            .emitters
+            .iter()
+            .any(|&(p, _)| cut(&self.tris[p as usize]))
+        {
+            return false;
+        }
+        let (ta, tb) = (n.cross(ra), rb.cross(n));
+        self.emitters
+            .iter()
+            .any(|&(prim, _)| wedge_cut(&self.tris[prim as usize], x, n, ta, tb).is_some())
+    }
+
+    /// The parts of an edge's arc seen from `x` behind which an emitter
+    /// triangle lies: per triangle, the angles of the part of the segment
+    /// where the arc's plane cuts it that lies inside the arc's wedge
+    /// ([`wedge_cut`]). `None` without such parts, or with more than
+    /// [`LAMP_TRIANGLES`] emitter triangles.
+    fn lamp_intervals(&self, x: DVec3, a: &EdgeArc) -> Option<LampParts> {
         if self.emitters.is_empty() || self.emitters.len() > LAMP_TRIANGLES {
             return None;
         }
         let mut out = [(0.0, 0.0); LAMP_TRIANGLES];
         let (mut count, mut total) = (0, 0.0);
+        let tb = a.rb.cross(a.n);
         for &(prim, _) in &self.emitters {
-            let tri = self.tris[prim as usize];
-            let h = tri.map(|v| (v - x).dot(n));
-            // Where the plane cuts the triangle's sides.
-            let mut angles = [0.0f64; 2];
-            let mut k = 0;
-            for i in 0..3 {
-                let (a, b) = (i, (i + 1) % 3);
-                if (h[a] > 0.0) != (h[b] > 0.0) && k < 2 {
-                    let s = h[a] / (h[a] - h[b]);
-                    let r = tri[a] + (tri[b] - tri[a]) * s - x;
-                    angles[k] = r.dot(t).atan2(r.dot(wa));
-                    k += 1;
-                }
-            }
-            if k < 2 {
+            let Some(ends) = wedge_cut(&self.tris[prim as usize], x, a.n, a.t, tb) else {
                 continue;
-            }
-            let (lo, hi) = (
-                angles[0].min(angles[1]).max(0.0),
-                angles[0].max(angles[1]).min(arc),
-            );
+            };
+            let [u, v] = ends.map(|r| r.dot(a.t).atan2(r.dot(a.wa)).clamp(0.0, a.arc));
+            let (lo, hi) = (u.min(v), u.max(v));
             if hi > lo {
                 out[count] = (lo, hi);
                 count += 1;
                 total += hi - lo;
             }
         }
-        (count > 0 && total > 0.0).then_some((out, count, total))
+        (count > 0 && total > 0.0).then_some(LampParts {
+            intervals: out,
+            count,
+            total,
+        })
     }
 
     /// A point on the moving edges seen through the footprint `rect` of
@@ -132,14 +291,171 @@ impl Space {
             inv_pdf: total * rate,
         })
     }
+
+    /// Per edge of `tree` (in its order), the weight the lamp strategy
+    /// draws it with: the angle of its arc seen from `x` with a lamp behind
+    /// over the distance to its midpoint (the arc's normal speed goes as
+    /// 1/distance), 0 unless it is a silhouette from `x` (a crease whose
+    /// faces both face `x`, or both away, shows no lamp past it, whatever
+    /// lies behind its arc),
+    /// and their total; all 0 when the tree holds more than [`LAMP_EDGES`]
+    /// edges or the lamps more than [`LAMP_TRIANGLES`] triangles.
+    #[inline]
+    fn lamp_overlaps(&self, x: DVec3, tree: &EdgeTree) -> ([f64; LAMP_EDGES], f64) {
+        let tables = self.edge_tables();
+        let ids = tree.edges();
+        let mut overlap = [0.0f64; LAMP_EDGES];
+        let mut total = 0.0;
+        if ids.len() > LAMP_EDGES
+            || self.emitters.is_empty()
+            || self.emitters.len() > LAMP_TRIANGLES
+        {
+            return (overlap, total);
+        }
+        for (k, &e) in ids.iter().enumerate() {
+            let edge = &tables.edges[e as usize];
+            if !is_silhouette(edge, &tables.edge_facts[e as usize], x) || !self.lamp_behind(x, edge)
+            {
+                continue;
+            }
+            if let Some(parts) = EdgeArc::new(edge, x).and_then(|a| self.lamp_intervals(x, &a)) {
+                let r = (0.5 * (edge.a + edge.b) - x).length();
+                let w = parts.total / r;
+                overlap[k] = w;
+                total += w;
+            }
+        }
+        (overlap, total)
+    }
+
+    // ANCHOR: edge_point
+    /// A point on the edges that can be discontinuities seen from `x` (all
+    /// of them if `all`, else the moving meshes'), `inv_pdf` per unit arc
+    /// length on the sphere. Two strategies, the density the mixture's
+    /// whichever drew the point:
+    ///
+    /// - the tree's: an edge drawn from the edge hierarchy, a point along
+    ///   its arc, half the time uniform in angle and half on the parts of
+    ///   the arc behind which a lamp lies;
+    /// - by lamp overlap (share [`LAMP_SHARE`], when the tree holds at
+    ///   most [`LAMP_EDGES`] edges and some silhouette's arc has a lamp
+    ///   behind): an edge in proportion to the angle of its arc with a
+    ///   lamp behind over its distance ([`Space::lamp_overlaps`]), a point
+    ///   uniform on those parts.
+    ///
+    /// Any rule for the lamp strategy's weights keeps the estimate
+    /// unbiased, so long as the density reported is that of the draws:
+    /// every term is evaluated from the same `(x, edge)` by the same
+    /// functions on both paths, and the tree's half keeps a floor on every
+    /// point of every discontinuity.
+    #[inline]
+    fn edge_point(&self, x: DVec3, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
+        let tables = self.edge_tables();
+        let (edges, facts, weights) = (&tables.edges, &tables.edge_facts, &tables.edge_weight);
+        let tree = if all {
+            &tables.all_edges
+        } else {
+            &tables.moving_edges
+        };
+        let ids = tree.edges();
+        // At the sensor's point (a probe's every path starts there) the
+        // lamp weights are computed once per tree.
+        let (overlap, lamp_total) = if x == self.scene.sensor().point() {
+            *self.sensor_lamps[all as usize].get_or_init(|| self.lamp_overlaps(x, tree))
+        } else {
+            self.lamp_overlaps(x, tree)
+        };
+        let share = if lamp_total > 0.0 { LAMP_SHARE } else { 0.0 };
+        let (index, p_tree, arc, lamps, alpha) = if u < share {
+            // By lamp overlap: the edge, then a point on its lamp parts.
+            let s = (u / share * lamp_total).min(lamp_total * (1.0 - f64::EPSILON));
+            let (mut acc, mut k) = (0.0, usize::MAX);
+            for (i, &o) in overlap[..ids.len()].iter().enumerate() {
+                if o <= 0.0 {
+                    continue;
+                }
+                k = i;
+                if s < acc + o {
+                    break;
+                }
+                acc += o;
+            }
+            // (Past the last part only by rounding: the last part then.)
+            let rest = ((s - acc) / overlap[k]).clamp(0.0, 1.0 - f64::EPSILON);
+            let index = ids[k];
+            let arc = EdgeArc::new(&edges[index as usize], x)?;
+            let lamps = self.lamp_intervals(x, &arc)?;
+            let alpha = lamps.pick(rest, arc.arc);
+            let p_tree = tree.probability(x, index, edges, facts, weights);
+            (index, p_tree, arc, Some(lamps), alpha)
+        } else {
+            // The tree's: half uniform in angle, half on the lamp parts.
+            let u = if share > 0.0 {
+                ((u - share) / (1.0 - share)).min(1.0 - f64::EPSILON)
+            } else {
+                u
+            };
+            let (index, p_tree, along) = tree.sample(x, u, edges, facts, weights)?;
+            let arc = EdgeArc::new(&edges[index as usize], x)?;
+            let lamps = self.lamp_intervals(x, &arc);
+            let alpha = match lamps {
+                Some(ref l) if along >= 0.5 => l.pick(2.0 * along - 1.0, arc.arc),
+                Some(_) => 2.0 * along * arc.arc,
+                None => along * arc.arc,
+            };
+            (index, p_tree, arc, lamps, alpha)
+        };
+        // The mixture's density per unit angle at alpha on this edge.
+        let (by_tree, by_lamp) = match lamps {
+            None => (p_tree / arc.arc, 0.0),
+            Some(ref l) => {
+                let cover = l.cover(alpha);
+                // The edge's share of the draws by lamp overlap (0 if the
+                // cheap test left it out, or the tree is too large for
+                // them), then its point's density.
+                let o = if share > 0.0 {
+                    tree.place(index)
+                        .and_then(|k| overlap.get(k).copied())
+                        .unwrap_or(0.0)
+                } else {
+                    0.0
+                };
+                (
+                    p_tree * (0.5 / arc.arc + 0.5 * cover / l.total),
+                    if o > 0.0 {
+                        o / lamp_total * cover / l.total
+                    } else {
+                        0.0
+                    },
+                )
+            }
+        };
+        let density = (1.0 - share) * by_tree + share * by_lamp;
+        let edge = &edges[index as usize];
+        let (s, c) = alpha.sin_cos();
+        let w = arc.wa * c + arc.t * s;
+        // Where the ray along w meets the edge's line, in the plane (x, a, b).
+        let d = edge.b - edge.a;
+        let tau = (-(arc.ra.cross(w).dot(arc.n)) / d.cross(w).dot(arc.n)).clamp(0.0, 1.0);
+        let q = edge.a + d * tau;
+        if !q.is_finite() || density.is_nan() || density <= 0.0 {
+            return None;
+        }
+        Some(BoundaryPoint {
+            q,
+            shape: edge.shape,
+            index,
+            inv_pdf: 1.0 / density,
+        })
+    }
+    // ANCHOR_END: edge_point
 }
 
 impl Boundaries for Space {
     // ANCHOR: sample_boundary
-    /// An edge drawn from the edge hierarchy (by weight among those that
-    /// can be discontinuities seen from `x`), a point along its arc (uniform
-    /// in angle, or on the parts with a lamp behind: a mixture of the two);
-    /// `inv_pdf` is per unit arc length on the sphere seen from `x`.
+    /// A point on the edges seen from the vertex ([`Space::edge_point`]),
+    /// or, at a camera pixel, on the moving edges seen through it;
+    /// `inv_pdf` is per unit arc length on the sphere of directions.
     #[inline]
     fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
         if let SpaceLobe::Pixel { rect, pixel, .. } = v.lobe {
@@ -148,78 +464,7 @@ impl Boundaries for Space {
             debug_assert!(!all, "a camera does not move");
             return self.pixel_boundary(v.x, pixel, &rect, u);
         }
-        let x = v.x;
-        let tree = if all {
-            &self.edge_tables().all_edges
-        } else {
-            &self.edge_tables().moving_edges
-        };
-        let (index, p, along) = tree.sample(
-            x,
-            u,
-            &self.edge_tables().edges,
-            &self.edge_tables().edge_facts,
-            &self.edge_tables().edge_weight,
-        )?;
-        let edge = &self.edge_tables().edges[index as usize];
-        // The point: uniform in angle along the edge's arc seen from x, so
-        // a long edge is sampled where it subtends the most (uniform in
-        // length, its far parts would be drawn as often as its near ones
-        // for a vanishing share of the arc).
-        let (ra, rb) = (edge.a - x, edge.b - x);
-        let n = ra.cross(rb);
-        let (sin_g, cos_g) = (n.length(), ra.dot(rb));
-        let arc = sin_g.atan2(cos_g);
-        if arc.is_nan() || arc <= 0.0 || sin_g == 0.0 {
-            return None; // seen end-on: no arc
-        }
-        let n = n / sin_g;
-        let wa = ra.normalize();
-        let t = n.cross(wa);
-        // Half the draws uniform in angle, half on the parts of the arc
-        // behind which a lamp lies (where the jump carries direct light):
-        // the density is the mixture's, whichever strategy drew the point.
-        let lamps = self.lamp_intervals(x, n, wa, t, arc);
-        let (alpha, density) = match lamps {
-            None => (along * arc, 1.0 / arc),
-            Some((ref intervals, count, total)) => {
-                let alpha = if along < 0.5 {
-                    2.0 * along * arc
-                } else {
-                    let mut left = (2.0 * along - 1.0) * total;
-                    let mut pick = intervals[count - 1];
-                    for iv in &intervals[..count] {
-                        let len = iv.1 - iv.0;
-                        if left < len {
-                            pick = *iv;
-                            break;
-                        }
-                        left -= len;
-                    }
-                    (pick.0 + left.min(pick.1 - pick.0)).clamp(0.0, arc)
-                };
-                let inside = intervals[..count]
-                    .iter()
-                    .filter(|iv| iv.0 <= alpha && alpha <= iv.1)
-                    .count() as f64;
-                (alpha, 0.5 / arc + 0.5 * inside / total)
-            }
-        };
-        let (s, c) = alpha.sin_cos();
-        let w = wa * c + t * s;
-        // Where the ray along w meets the edge's line, in the plane (x, a, b).
-        let d = edge.b - edge.a;
-        let tau = (-(ra.cross(w).dot(n)) / d.cross(w).dot(n)).clamp(0.0, 1.0);
-        let q = edge.a + d * tau;
-        if !q.is_finite() {
-            return None;
-        }
-        Some(BoundaryPoint {
-            q,
-            shape: edge.shape,
-            index,
-            inv_pdf: 1.0 / (p * density),
-        })
+        self.edge_point(v.x, all, u)
     }
     // ANCHOR_END: sample_boundary
 
@@ -289,5 +534,85 @@ impl Boundaries for Space {
         velocity: impl Fn(DVec3, u32) -> DVec3,
     ) -> (DVec3, f64) {
         self.fibre_velocity(warp, slot, x, w, u, spin, velocity)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::file;
+    use std::path::Path;
+    use std::sync::Arc;
+
+    /// `E[inv_pdf · 1{q in a piece of arc}]` is the piece's length
+    /// whatever the density, if `inv_pdf` is the inverse of the density
+    /// the points are drawn with: on the fog-free showcase (a cube, 12
+    /// moving edges, under a two-triangle lamp), from floor points in the
+    /// cube's penumbra, lit and in its umbra, and from a point on the cube,
+    /// with the moving edges (rendering) and with every edge (transport's
+    /// gradient walks), a fine grid of `u` and `Σ inv_pdf` per eighth of
+    /// each edge's arc against its angle, within 0.4 % (a pdf wrong by 2 %
+    /// on the lamp parts fails it).
+    #[test]
+    fn the_boundary_density_is_that_of_the_draws() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mesh/showcase_nofog.toml");
+        let space = Space::new(Arc::new(file::load(&path).unwrap()));
+        let tables = space.edge_tables();
+        let n = 1_600_000;
+        let bins = 8;
+        let mut with_lamp = 0;
+        for x in [
+            DVec3::new(-0.3, 0.55, 0.0),
+            DVec3::new(0.25, 0.1, 0.0),
+            DVec3::new(-0.3, 0.0, 0.0),
+            DVec3::new(1.5, -1.0, 0.0),
+            DVec3::new(-0.3, 0.0, 0.85),
+        ] {
+            for all in [false, true] {
+                let tree = if all {
+                    &tables.all_edges
+                } else {
+                    &tables.moving_edges
+                };
+                if space.lamp_overlaps(x, tree).1 > 0.0 {
+                    with_lamp += 1;
+                }
+                let mut sums = vec![0.0; tables.edges.len() * bins];
+                let mut arcs = vec![0.0; tables.edges.len()];
+                for k in 0..n {
+                    let u = (k as f64 + 0.5) / n as f64;
+                    let Some(b) = space.edge_point(x, all, u) else {
+                        continue;
+                    };
+                    assert!(b.inv_pdf.is_finite() && b.inv_pdf > 0.0);
+                    let e = b.index as usize;
+                    let edge = &tables.edges[e];
+                    let (ra, rb, rq) = (edge.a - x, edge.b - x, b.q - x);
+                    let arc = ra.cross(rb).length().atan2(ra.dot(rb));
+                    let alpha = ra.cross(rq).length().atan2(ra.dot(rq));
+                    let bin = ((alpha / arc * bins as f64) as usize).min(bins - 1);
+                    sums[e * bins + bin] += b.inv_pdf / n as f64;
+                    arcs[e] = arc;
+                }
+                for &e in tree.edges() {
+                    let e = e as usize;
+                    // Every edge here is a discontinuity from everywhere
+                    // (open, or a reflector's crease): each must be drawn.
+                    assert!(arcs[e] > 0.0, "x {x}, all {all}: edge {e} never drawn");
+                    for bin in 0..bins {
+                        let want = arcs[e] / bins as f64;
+                        let got = sums[e * bins + bin];
+                        assert!(
+                            (got / want - 1.0).abs() < 0.004,
+                            "x {x}, all {all}, edge {e}, bin {bin}: {got} against {want}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(
+            with_lamp >= 4,
+            "{with_lamp} views with a lamp behind some edge"
+        );
     }
 }

@@ -82,6 +82,8 @@ pub struct EdgeTree {
     nodes: Vec<Node>,
     /// Edge indices in leaf order.
     order: Vec<u32>,
+    /// Per edge index, its place in `order` (`u32::MAX`: not in the tree).
+    place: Vec<u32>,
 }
 
 /// Whether edge `e` (with `facts`) can be a discontinuity seen from `x`.
@@ -102,6 +104,7 @@ impl EdgeTree {
         let mut tree = EdgeTree {
             nodes: Vec::new(),
             order: ids,
+            place: Vec::new(),
         };
         if tree.order.is_empty() {
             return tree;
@@ -120,7 +123,27 @@ impl EdgeTree {
         });
         let n = tree.order.len();
         tree.build(0, 0, n, edges, facts, weights);
+        let last = tree.order.iter().max().map_or(0, |&i| i as usize + 1);
+        tree.place = vec![u32::MAX; last];
+        for (k, &i) in tree.order.iter().enumerate() {
+            tree.place[i as usize] = k as u32;
+        }
         tree
+    }
+
+    /// The edges in the tree, in leaf order.
+    #[inline]
+    pub fn edges(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// The place of edge `e` in [`EdgeTree::edges`], if it is in the tree.
+    #[inline]
+    pub fn place(&self, e: u32) -> Option<usize> {
+        match self.place.get(e as usize) {
+            Some(&k) if k != u32::MAX => Some(k as usize),
+            _ => None,
+        }
     }
 
     fn build(
@@ -331,6 +354,76 @@ impl EdgeTree {
         }
     }
 
+    /// The probability with which [`EdgeTree::sample`] draws edge `e` from
+    /// `x` (0 if it cannot: not in the tree, culled, or not a
+    /// discontinuity from `x`): the one descent toward `e`'s leaf, each
+    /// choice's probability under both halves of the mixture exactly as
+    /// `sample` computes them, so the two agree to the last bit.
+    #[inline]
+    pub fn probability(
+        &self,
+        x: DVec3,
+        e: u32,
+        edges: &[Edge],
+        facts: &[EdgeFacts],
+        weights: &[f64],
+    ) -> f64 {
+        let Some(target) = self.place(e) else {
+            return 0.0;
+        };
+        if self.nodes.is_empty() || !self.open(0, x) {
+            return 0.0;
+        }
+        // Node `i` holds the edges `order[start..end]`; a split puts the
+        // first half (rounded down) on the left, as `build` does.
+        let (mut i, mut start, mut end) = (0, 0, self.order.len());
+        let (mut p_near, mut p_weight) = (1.0, 1.0);
+        loop {
+            let n = self.nodes[i];
+            if n.count > 0 {
+                let ids = &self.order[n.first as usize..(n.first + n.count) as usize];
+                let (mut by_near, mut by_weight) = ([0.0; LEAF], [0.0; LEAF]);
+                for (k, &f) in ids.iter().enumerate() {
+                    if is_discontinuity(&edges[f as usize], &facts[f as usize], x) {
+                        by_weight[k] = weights[f as usize];
+                        by_near[k] = edge_importance(&edges[f as usize], weights[f as usize], x);
+                    }
+                }
+                let (t_near, t_weight): (f64, f64) = (by_near.iter().sum(), by_weight.iter().sum());
+                if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
+                    return 0.0;
+                }
+                let k = target - n.first as usize;
+                return 0.5 * (p_near * by_near[k] / t_near + p_weight * by_weight[k] / t_weight);
+            }
+            let (l, r) = (n.first as usize, n.first as usize + 1);
+            let (open_l, open_r) = (self.open(l, x), self.open(r, x));
+            let pair = |f: &dyn Fn(usize) -> f64| {
+                (
+                    if open_l { f(l) } else { 0.0 },
+                    if open_r { f(r) } else { 0.0 },
+                )
+            };
+            let (nl, nr) = pair(&|c| self.importance(c, x));
+            let (wl, wr) = pair(&|c| self.nodes[c].weight);
+            let (t_near, t_weight) = (nl + nr, wl + wr);
+            if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
+                return 0.0;
+            }
+            let (near_l, weight_l) = (nl / t_near, wl / t_weight);
+            let mid = start + (end - start) / 2;
+            if target < mid {
+                p_near *= near_l;
+                p_weight *= weight_l;
+                (i, end) = (l, mid);
+            } else {
+                p_near *= 1.0 - near_l;
+                p_weight *= 1.0 - weight_l;
+                (i, start) = (r, mid);
+            }
+        }
+    }
+
     /// Calls `f` with every discontinuity edge seen from `x` that may cross
     /// the plane through `x` with unit normal `m` where `(q − x)·side > 0`.
     #[inline]
@@ -467,6 +560,92 @@ mod tests {
             let mean = |q: &[(f64, f64)]| q.iter().map(|v| v.1).sum::<f64>() / q.len() as f64;
             let (close, far) = (mean(&by_distance[..50]), mean(&by_distance[150..]));
             assert!(close > 1.3 * far, "near {close}, far {far}");
+        }
+    }
+    /// Edges of a faceted sphere (each with two faces' normals a little
+    /// apart, so nodes are culled and some descents dead-end):
+    /// [`EdgeTree::probability`] must be, to the last bit, the probability
+    /// `sample` reports for every edge it draws, match the frequencies of a
+    /// fine grid of `u`, and sum over the edges to the share of `u` that
+    /// draws something.
+    #[test]
+    fn the_probability_of_an_edge_is_that_of_its_draws() {
+        let mut state = 11u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut edges, mut facts, mut weights) = (Vec::new(), Vec::new(), Vec::new());
+        let m = 300;
+        for _ in 0..m {
+            let z: f64 = 2.0 * next() - 1.0;
+            let phi = 2.0 * std::f64::consts::PI * next();
+            let r = (1.0 - z * z).sqrt();
+            let c = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+            let t = c.any_orthonormal_vector();
+            let t = (t * (next() - 0.5) + c.cross(t) * (next() - 0.5)).normalize();
+            let side = c.cross(t);
+            let tilt = 0.05 + 0.3 * next();
+            edges.push(Edge {
+                a: c - t * 0.05,
+                b: c + t * 0.05,
+                faces: [0, 1],
+                shape: 0,
+            });
+            facts.push(EdgeFacts {
+                normals: [(c + side * tilt).normalize(), (c - side * tilt).normalize()],
+                always: false,
+            });
+            weights.push(0.1 * 2.0 * tilt.atan() / std::f64::consts::PI);
+        }
+        // The tree over a subset (every edge but each fifth), as the
+        // moving edges are.
+        let ids: Vec<u32> = (0..m as u32).filter(|i| i % 5 != 0).collect();
+        let tree = EdgeTree::new(&edges, &facts, &weights, ids);
+        for x in [DVec3::new(2.5, 0.3, -0.4), DVec3::new(-0.2, 1.6, 1.1)] {
+            let n = 400_000;
+            let mut drawn = vec![0usize; m];
+            let mut none = 0;
+            for k in 0..n {
+                let u = (k as f64 + 0.5) / n as f64;
+                match tree.sample(x, u, &edges, &facts, &weights) {
+                    Some((e, p, _)) => {
+                        drawn[e as usize] += 1;
+                        let q = tree.probability(x, e, &edges, &facts, &weights);
+                        assert_eq!(q, p, "edge {e}");
+                    }
+                    None => none += 1,
+                }
+            }
+            let probs: Vec<f64> = (0..m as u32)
+                .map(|e| tree.probability(x, e, &edges, &facts, &weights))
+                .collect();
+            let total: f64 = probs.iter().sum();
+            let live = 1.0 - none as f64 / n as f64;
+            assert!(
+                (total - live).abs() < 2000.0 / n as f64,
+                "Σ p = {total} against {live} drawn"
+            );
+            let silhouettes = (0..m)
+                .filter(|&e| is_discontinuity(&edges[e], &facts[e], x))
+                .count();
+            assert!(silhouettes > 10 && silhouettes < m / 2, "{silhouettes}");
+            for e in 0..m {
+                if e % 5 == 0 {
+                    assert_eq!(probs[e], 0.0, "edge {e} is not in the tree");
+                }
+                if !is_discontinuity(&edges[e], &facts[e], x) {
+                    assert_eq!(probs[e], 0.0, "edge {e} is no silhouette");
+                }
+                let share = drawn[e] as f64 / n as f64;
+                assert!(
+                    (share - probs[e]).abs() < 40.0 / n as f64,
+                    "edge {e}: {share} against {}",
+                    probs[e]
+                );
+            }
         }
     }
 }

@@ -4,6 +4,7 @@
 //! discontinuities (silhouette and crease edges,
 //! [`Boundaries`](crate::path::Boundaries)) are in
 //! [`boundaries`](super::boundaries). Book: chapter "Three dimensions".
+use super::boundaries::LAMP_EDGES;
 use super::bvh::TriangleBvh;
 use super::camera::{CameraFrame, PixelEdges};
 use super::edges::{EdgeFacts, EdgeTree};
@@ -63,6 +64,10 @@ pub struct Space {
     /// What the sensor's point sees of the edges (built on first use, by
     /// the expectation method).
     sensor_view: OnceLock<SensorView>,
+    /// The boundary draws' lamp weights of the moving edges and of all
+    /// edges seen from the sensor's point, where every path starts (built
+    /// on first use).
+    pub(super) sensor_lamps: [OnceLock<([f64; LAMP_EDGES], f64)>; 2],
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
     pub(super) pole_rules: Vec<PoleRule>,
@@ -164,6 +169,7 @@ impl Space {
             camera,
             pixel_edges: OnceLock::new(),
             sensor_view: OnceLock::new(),
+            sensor_lamps: [OnceLock::new(), OnceLock::new()],
             pole_rules,
             slot_field,
         }
