@@ -23,9 +23,9 @@
 //! predicted 4015 spp; 2331 spp measured 11 % and 24 %). The final
 //! extrapolation, from a `rel` of 10–30 %, is the number to use.
 //!
-//! Measured on 2 shared cores, showcase_nofog (budget 50 s): time to 5 %
-//! (cube_x, cube_rot) rendering 244 s, 1115 s; transport 389 s, 1194 s;
-//! expectation 649 s, 2693 s; fd 132 s, 17194 s (~1 µs per path).
+//! Measured 2026-11-24 after the lamp-overlap draws (2 shared cores, budget
+//! 20 s): time to 5 % (cube_x, cube_rot) rendering 34 s, 325 s; transport
+//! 119 s, 503 s; expectation 212 s; fd 129 s (cube_x).
 //!
 //! `cargo run --release --no-default-features --example mesh_camera_perf --
 //! [SCENE] [PILOT] [BUDGET] [THREADS] [OUT]`: defaults
