@@ -65,6 +65,30 @@ fn edge_importance(e: &Edge, weight: f64, x: DVec3) -> f64 {
     weight / d2
 }
 
+/// A leaf's edges' importances seen from `x`, by distance and by weight
+/// (0 for an edge that is no discontinuity from `x`), and their totals: what
+/// [`EdgeTree::sample`] draws a leaf's edge by and
+/// [`EdgeTree::probability`] reads back.
+#[inline]
+#[allow(clippy::type_complexity)]
+fn leaf_importances(
+    ids: &[u32],
+    edges: &[Edge],
+    facts: &[EdgeFacts],
+    weights: &[f64],
+    x: DVec3,
+) -> ([f64; LEAF], [f64; LEAF], f64, f64) {
+    let (mut by_near, mut by_weight) = ([0.0; LEAF], [0.0; LEAF]);
+    for (k, &e) in ids.iter().enumerate() {
+        if is_discontinuity(&edges[e as usize], &facts[e as usize], x) {
+            by_weight[k] = weights[e as usize];
+            by_near[k] = edge_importance(&edges[e as usize], weights[e as usize], x);
+        }
+    }
+    let (t_near, t_weight): (f64, f64) = (by_near.iter().sum(), by_weight.iter().sum());
+    (by_near, by_weight, t_near, t_weight)
+}
+
 /// Per edge, what the tree needs: its faces' normals and whether it is
 /// always a discontinuity.
 #[derive(Debug, Clone, Copy)]
@@ -291,14 +315,8 @@ impl EdgeTree {
             let n = self.nodes[i];
             if n.count > 0 {
                 let ids = &self.order[n.first as usize..(n.first + n.count) as usize];
-                let (mut by_near, mut by_weight) = ([0.0; LEAF], [0.0; LEAF]);
-                for (k, &e) in ids.iter().enumerate() {
-                    if is_discontinuity(&edges[e as usize], &facts[e as usize], x) {
-                        by_weight[k] = weights[e as usize];
-                        by_near[k] = edge_importance(&edges[e as usize], weights[e as usize], x);
-                    }
-                }
-                let (t_near, t_weight): (f64, f64) = (by_near.iter().sum(), by_weight.iter().sum());
+                let (by_near, by_weight, t_near, t_weight) =
+                    leaf_importances(ids, edges, facts, weights, x);
                 if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
                     return None;
                 }
@@ -382,14 +400,8 @@ impl EdgeTree {
             let n = self.nodes[i];
             if n.count > 0 {
                 let ids = &self.order[n.first as usize..(n.first + n.count) as usize];
-                let (mut by_near, mut by_weight) = ([0.0; LEAF], [0.0; LEAF]);
-                for (k, &f) in ids.iter().enumerate() {
-                    if is_discontinuity(&edges[f as usize], &facts[f as usize], x) {
-                        by_weight[k] = weights[f as usize];
-                        by_near[k] = edge_importance(&edges[f as usize], weights[f as usize], x);
-                    }
-                }
-                let (t_near, t_weight): (f64, f64) = (by_near.iter().sum(), by_weight.iter().sum());
+                let (by_near, by_weight, t_near, t_weight) =
+                    leaf_importances(ids, edges, facts, weights, x);
                 if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
                     return 0.0;
                 }
