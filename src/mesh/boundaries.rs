@@ -453,7 +453,7 @@ impl Space {
 
 impl Boundaries for Space {
     // ANCHOR: sample_boundary
-    /// A point on the edges seen from the vertex ([`Space::edge_point`]),
+    /// A point on the edges seen from the vertex (`Space::edge_point`),
     /// or, at a camera pixel, on the moving edges seen through it;
     /// `inv_pdf` is per unit arc length on the sphere of directions.
     #[inline]
