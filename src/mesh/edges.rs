@@ -343,20 +343,7 @@ impl EdgeTree {
                 return None;
             }
             let (l, r) = (n.first as usize, n.first as usize + 1);
-            let (open_l, open_r) = (self.open(l, x), self.open(r, x));
-            let pair = |f: &dyn Fn(usize) -> f64| {
-                (
-                    if open_l { f(l) } else { 0.0 },
-                    if open_r { f(r) } else { 0.0 },
-                )
-            };
-            let (nl, nr) = pair(&|c| self.importance(c, x));
-            let (wl, wr) = pair(&|c| self.nodes[c].weight);
-            let (t_near, t_weight) = (nl + nr, wl + wr);
-            if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
-                return None;
-            }
-            let (near_l, weight_l) = (nl / t_near, wl / t_weight);
+            let (near_l, weight_l) = self.left_shares(l, r, x)?;
             let pl = if near { near_l } else { weight_l };
             if u < pl {
                 u /= pl;
@@ -370,6 +357,30 @@ impl EdgeTree {
                 i = r;
             }
         }
+    }
+
+    /// The left child's share of a descent through the children `l` and
+    /// `r` seen from `x`, under each half of the mixture (by distance, by
+    /// weight), a culled child counting 0; `None` when both are culled or
+    /// the estimates are degenerate (a dead end). What
+    /// [`EdgeTree::sample`] chooses by and [`EdgeTree::probability`] reads
+    /// back.
+    #[inline]
+    fn left_shares(&self, l: usize, r: usize, x: DVec3) -> Option<(f64, f64)> {
+        let (open_l, open_r) = (self.open(l, x), self.open(r, x));
+        let pair = |f: &dyn Fn(usize) -> f64| {
+            (
+                if open_l { f(l) } else { 0.0 },
+                if open_r { f(r) } else { 0.0 },
+            )
+        };
+        let (nl, nr) = pair(&|c| self.importance(c, x));
+        let (wl, wr) = pair(&|c| self.nodes[c].weight);
+        let (t_near, t_weight) = (nl + nr, wl + wr);
+        if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
+            return None;
+        }
+        Some((nl / t_near, wl / t_weight))
     }
 
     /// The probability with which [`EdgeTree::sample`] draws edge `e` from
@@ -409,20 +420,9 @@ impl EdgeTree {
                 return 0.5 * (p_near * by_near[k] / t_near + p_weight * by_weight[k] / t_weight);
             }
             let (l, r) = (n.first as usize, n.first as usize + 1);
-            let (open_l, open_r) = (self.open(l, x), self.open(r, x));
-            let pair = |f: &dyn Fn(usize) -> f64| {
-                (
-                    if open_l { f(l) } else { 0.0 },
-                    if open_r { f(r) } else { 0.0 },
-                )
-            };
-            let (nl, nr) = pair(&|c| self.importance(c, x));
-            let (wl, wr) = pair(&|c| self.nodes[c].weight);
-            let (t_near, t_weight) = (nl + nr, wl + wr);
-            if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
+            let Some((near_l, weight_l)) = self.left_shares(l, r, x) else {
                 return 0.0;
-            }
-            let (near_l, weight_l) = (nl / t_near, wl / t_weight);
+            };
             let mid = start + (end - start) / 2;
             if target < mid {
                 p_near *= near_l;
