@@ -41,8 +41,9 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
                 w_in: G::V::ZERO,
                 frame: Frame::Sensor,
                 beta: 1.0,
-                // Its warp knots are searched like any vertex's (flatland
-                // precomputes them for the irradiance sensor only).
+                // Not `at_sensor`: flatland precomputes knots for the
+                // irradiance sensor only. (3D's sensor view serves any
+                // vertex at the sensor's point, the pinhole included.)
                 at_sensor: false,
             };
             let w = hooks.scatter(g, rng, &v);
