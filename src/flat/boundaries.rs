@@ -2,7 +2,7 @@
 //! corners of opaque shapes (drawn by weight for rendering's and
 //! transport's jumps, with what either side of a corner sees) and the
 //! expectation method's warp, piecewise linear on the circle between the
-//! nearest visible corners (by the corner grid, or a scan for few corners).
+//! nearest visible corners (by the corner tree, or a scan for few corners).
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Corner jumps" and "The warp field".
 use super::geometry::{NO_SEGMENT, cross, perp};
@@ -10,7 +10,7 @@ use super::lobe::FlatLobe;
 use super::scene::{Phase, Sensor as FlatSensor};
 use super::space::{Knot, Plane};
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, NO_PRIM, Side};
+use crate::path::{Boundaries, BoundaryPoint, Hit, NO_PRIM, Side};
 use glam::DVec2;
 use std::f64::consts::TAU;
 
@@ -116,12 +116,12 @@ impl Boundaries for Plane {
 
     type Warp = FlatWarp;
 
-    fn warp(&self, v: &Vertex<Self>, w: DVec2) -> FlatWarp {
+    fn warp(&self, v: &Vertex<Self>, w: DVec2, ahead: Option<Option<Hit>>) -> FlatWarp {
         let horizons = v.lobe.horizons(w);
         let (ccw, cw) = if v.at_sensor {
             self.sensor_knots(w, horizons)
         } else {
-            self.nearest_knots(v.x, v.skip, w, horizons)
+            self.nearest_knots(v.x, v.skip, w, ahead, horizons)
         };
         FlatWarp { ccw, cw, horizons }
     }
@@ -185,6 +185,7 @@ impl Plane {
         x: DVec2,
         skip: u32,
         w: DVec2,
+        ahead: Option<Option<Hit>>,
         (h_ccw, h_cw): (f64, f64),
     ) -> (Option<Knot>, Option<Knot>) {
         let limit = |h: f64| {
@@ -196,7 +197,7 @@ impl Plane {
             }
         };
         let (lim_ccw, lim_cw) = (limit(h_ccw), limit(h_cw));
-        if let Some(knots) = self.knots_in_triangles(x, skip, w, lim_ccw, lim_cw) {
+        if let Some(knots) = self.knots_in_triangles(x, skip, w, ahead, lim_ccw, lim_cw) {
             return knots;
         }
         self.scan_knots(x, skip, w, lim_ccw, lim_cw)
@@ -257,23 +258,33 @@ impl Plane {
         (knot(ccw, true), knot(cw, false))
     }
 
-    /// [`Self::nearest_knots`] through the corner grid: the nearest visible
+    /// [`Self::nearest_knots`] through the corner tree: the nearest visible
     /// corner on each side is the hit segment's end there or the
     /// smallest-angle corner inside the triangle (vertex, hit point, end);
-    /// the module `corners` proves it. `None` (use the scan) without a grid
+    /// the module `corners` proves it. `None` (use the scan) without a tree
     /// or when the direction hits nothing opaque.
     fn knots_in_triangles(
         &self,
         x: DVec2,
         skip: u32,
         w: DVec2,
+        ahead: Option<Option<Hit>>,
         lim_ccw: f64,
         lim_cw: f64,
     ) -> Option<(Option<Knot>, Option<Knot>)> {
         let scene = &*self.scene;
-        let grid = scene.corner_grid()?;
-        let Some((t, seg, k_hit)) = scene.opaque_hit(x, w, skip) else {
-            return Some(self.knots_escaping(grid, x, w, lim_ccw, lim_cw));
+        let tree = scene.corner_tree()?;
+        // The first opaque segment along w: the caller's hit when it is one
+        // (the opaque caster's answer is the same segment at the same t).
+        let first = match ahead {
+            Some(None) => None,
+            Some(Some(h)) if scene.shape_of(h.prim).surface.is_opaque() => {
+                Some((h.t, scene.segments()[h.prim as usize], scene.owner(h.prim)))
+            }
+            _ => scene.opaque_hit(x, w, skip),
+        };
+        let Some((t, seg, k_hit)) = first else {
+            return Some(self.knots_escaping(tree, x, w, lim_ccw, lim_cw));
         };
         let p = x + t * w;
         let (sa, sb) = (cross(w, seg.a - x), cross(w, seg.b - x));
@@ -285,27 +296,31 @@ impl Plane {
             return None; // the ray grazes an end: let the scan decide
         };
         let corners = scene.corners();
-        let side = |e: DVec2, lim: f64, ccw: bool| -> Option<Knot> {
-            let angle = |q: DVec2| {
-                let r = q - x;
-                let pa = pseudo_angle(w.dot(r), cross(w, r));
-                if ccw { pa } else { 4.0 - pa }
-            };
-            let mut best: Option<(f64, DVec2, u32)> = None;
-            let pe = angle(e);
-            if pe < lim {
-                best = Some((pe, e, k_hit));
-            }
-            grid.near_triangle(x, p, e, |i| {
-                let (q, k) = corners[i as usize];
-                let pq = angle(q);
-                if pq < lim && best.is_none_or(|b| pq < b.0) && super::corners::inside(x, p, e, q) {
-                    best = Some((pq, q, k));
-                }
-            });
-            best.map(|(_, q, k)| knot(x, w, (q, k), ccw))
+        let angle = |q: DVec2, ccw: bool| {
+            let r = q - x;
+            let pa = pseudo_angle(w.dot(r), cross(w, r));
+            if ccw { pa } else { 4.0 - pa }
         };
-        Some((side(e_ccw, lim_ccw, true), side(e_cw, lim_cw, false)))
+        // Per side (ccw, cw): its triangle's far end, its limit, and the
+        // best corner so far (the segment's end, if within the limit).
+        let mut sides = [(e_ccw, lim_ccw, true), (e_cw, lim_cw, false)].map(|(e, lim, ccw)| {
+            let pe = angle(e, ccw);
+            (e, lim, ccw, (pe < lim).then_some((pe, e, k_hit)))
+        });
+        // One search over both triangles: together they make (x, e_ccw, e_cw).
+        tree.near_triangle(x, e_ccw, e_cw, |i| {
+            let (q, k) = corners[i as usize];
+            for (e, lim, ccw, best) in &mut sides {
+                let pq = angle(q, *ccw);
+                if pq < *lim && best.is_none_or(|b| pq < b.0) && super::corners::inside(x, p, *e, q)
+                {
+                    *best = Some((pq, q, k));
+                }
+            }
+        });
+        let [ccw, cw] =
+            sides.map(|(_, _, ccw, best)| best.map(|(_, q, k)| knot(x, w, (q, k), ccw)));
+        Some((ccw, cw))
     }
 
     /// The nearest visible corners on either side of a direction that hits
@@ -318,13 +333,13 @@ impl Plane {
     /// corner), around the box up to the lobe's horizon.
     fn knots_escaping(
         &self,
-        grid: &super::corners::CornerGrid,
+        tree: &super::corners::CornerTree,
         x: DVec2,
         w: DVec2,
         lim_ccw: f64,
         lim_cw: f64,
     ) -> (Option<Knot>, Option<Knot>) {
-        let (lo, hi) = grid.bounds();
+        let (lo, hi) = tree.bounds();
         let margin = 0.01 * (hi - lo).max_element().max(f64::MIN_POSITIVE);
         let (lo, hi) = (lo.min(x) - margin, hi.max(x) + margin);
         // Box corners counter-clockwise; the exit edge i runs box[i] → box[i+1].
@@ -361,7 +376,7 @@ impl Plane {
                     (_, false) => boxc[(i + 4 - step) % 4],
                 };
                 let mut best: Option<(f64, DVec2, u32)> = None;
-                grid.near_triangle(x, from, e, |c| {
+                tree.near_triangle(x, from, e, |c| {
                     let (q, k) = corners[c as usize];
                     let pq = angle(q);
                     if pq < lim
@@ -472,7 +487,7 @@ pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
         beta: 1.0,
         at_sensor,
     };
-    let field = plane.warp(&v, w);
+    let field = plane.warp(&v, w, None);
     (0..n)
         .map(|j| {
             let velocity = |q: DVec2, k: u32| {
@@ -497,7 +512,7 @@ mod tests {
     use std::sync::Arc;
 
     /// A reflecting vault open at the bottom (rays escape there) over an
-    /// occluder and a lamp, with enough corners for the grid.
+    /// occluder and a lamp, with enough corners for the tree.
     fn vault() -> Plane {
         let arc = |n: usize, r0: f64| -> Vec<DVec2> {
             (0..=n)
@@ -540,9 +555,9 @@ mod tests {
     }
 
     #[test]
-    fn the_grid_finds_the_knots_the_scan_finds() {
+    fn the_tree_finds_the_knots_the_scan_finds() {
         let plane = vault();
-        assert!(plane.scene.corner_grid().is_some());
+        assert!(plane.scene.corner_tree().is_some());
         let mut rng = crate::rng::PathRng::seed_from_u64(9);
         let (mut escaping, mut hitting) = (0, 0);
         for _ in 0..4000 {
@@ -553,7 +568,8 @@ mod tests {
             let w = super::super::geometry::direction(rng.random::<f64>() * TAU);
             let limits = [(4.0, 4.0), (2.0, 2.0), (1.5, 0.7)];
             let (lim_ccw, lim_cw) = limits[rng.random_range(0..3)];
-            let Some(grid) = plane.knots_in_triangles(x, NO_SEGMENT, w, lim_ccw, lim_cw) else {
+            let Some(tree) = plane.knots_in_triangles(x, NO_SEGMENT, w, None, lim_ccw, lim_cw)
+            else {
                 continue;
             };
             if plane.scene.opaque_hit(x, w, NO_SEGMENT).is_some() {
@@ -563,8 +579,8 @@ mod tests {
             }
             let scan = plane.scan_knots(x, NO_SEGMENT, w, lim_ccw, lim_cw);
             let key = |k: Option<Knot>| k.map(|k| (k.1.x, k.1.y));
-            assert_eq!(key(grid.0), key(scan.0), "ccw at {x} along {w}");
-            assert_eq!(key(grid.1), key(scan.1), "cw at {x} along {w}");
+            assert_eq!(key(tree.0), key(scan.0), "ccw at {x} along {w}");
+            assert_eq!(key(tree.1), key(scan.1), "cw at {x} along {w}");
         }
         assert!(escaping > 300 && hitting > 300, "{escaping} {hitting}");
     }

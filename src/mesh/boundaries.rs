@@ -34,7 +34,7 @@ use super::space::Edge;
 use super::space::Space;
 use super::warp::SpaceWarp;
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, NO_PRIM, Prim, Side};
+use crate::path::{Boundaries, BoundaryPoint, Hit, NO_PRIM, Prim, Side};
 use glam::DVec3;
 
 impl Space {
@@ -515,7 +515,7 @@ impl Boundaries for Space {
     /// The fibre warp of [`super::warp`].
     type Warp = SpaceWarp;
 
-    fn warp(&self, v: &Vertex<Self>, w: DVec3) -> SpaceWarp {
+    fn warp(&self, v: &Vertex<Self>, w: DVec3, _ahead: Option<Option<Hit>>) -> SpaceWarp {
         self.fibre_warp(v, w)
     }
 

@@ -11,7 +11,7 @@
 //! `ṫ_b = (v − u − t_b η̇)·n / (η·n)` (book: "Flatland: one deformation,
 //! three estimators", *the hit point's velocity*), in the plane and in space.
 use super::rendering::Rendering;
-use super::walk::{Vertex, light_sample, transmittance};
+use super::walk::{Vertex, light_sample, transmittance_by};
 use super::{Boundaries, Geometry, Hit, Vector};
 use crate::estimator::within_rounding;
 use crate::rng::PathRng;
@@ -426,6 +426,17 @@ impl<V: Vector> Scratch<V> {
         }
     }
 
+    /// A copy of `d` (the state a connection or nested path starts from).
+    #[inline]
+    pub fn take_copy(&mut self, d: &Deform<V>) -> Deform<V> {
+        let mut t = match self.free.pop() {
+            Some(t) if t.len() == d.len() => t,
+            _ => Deform::new(d.len()),
+        };
+        t.copy_from(d);
+        t
+    }
+
     /// Returns a state for reuse.
     #[inline]
     pub fn give(&mut self, d: Deform<V>) {
@@ -445,7 +456,9 @@ impl<V: Vector> Scratch<V> {
 /// differentiated (book: "Next-event estimation in the derivative walks").
 /// With `precheck`, a blocked connection is found by a plain shadow walk
 /// before `direction` runs (worth it when `direction` costs more than the
-/// extra ray: the expectation method's warp); the result is the same.
+/// extra ray: the expectation method's warp); its hits are kept, handed to
+/// `direction` (the first: `Some(hit)`) and replayed to the hooks, so no
+/// ray is cast twice and the result is the same.
 #[allow(clippy::too_many_arguments)]
 pub fn connect<G: Boundaries>(
     g: &G,
@@ -456,7 +469,7 @@ pub fn connect<G: Boundaries>(
     v: &Vertex<G>,
     frozen: bool,
     precheck: bool,
-    direction: impl FnOnce(&mut Deform<G::V>, G::V),
+    direction: impl FnOnce(&mut Deform<G::V>, G::V, Option<Option<Hit>>),
 ) -> f64 {
     let Some((w, p, c)) = light_sample(g, rng, v) else {
         return 0.0;
@@ -464,19 +477,24 @@ pub fn connect<G: Boundaries>(
     // A blocked connection adds nothing, whatever its direction's
     // velocity: a direction rule that costs more than a shadow ray (the
     // expectation method's warp) is worth skipping there.
-    if precheck && transmittance(g, &mut (), v.x, w, v.medium, v.skip, p) == 0.0 {
-        return 0.0;
+    let mut record = Recorded::default();
+    if precheck {
+        let cast = |x, w, skip| record.cast(g, x, w, skip);
+        if transmittance_by(g, &mut (), v.x, w, v.medium, v.skip, p, cast) == 0.0 {
+            return 0.0;
+        }
     }
-    let mut tmp = scratch.take(d.len());
-    tmp.copy_from(d);
-    direction(&mut tmp, w);
+    let mut tmp = scratch.take_copy(d);
+    direction(&mut tmp, w, precheck.then(|| record.first()));
     let mut follow = Rendering {
         slots,
         scratch,
         d: tmp,
         frozen,
     };
-    let contribution = c * transmittance(g, &mut follow, v.x, w, v.medium, v.skip, p);
+    let mut replay = 0;
+    let cast = |x, w, skip| record.replay(&mut replay, g, x, w, skip);
+    let contribution = c * transmittance_by(g, &mut follow, v.x, w, v.medium, v.skip, p, cast);
     let Rendering {
         d: tmp, scratch, ..
     } = follow;
@@ -488,5 +506,51 @@ pub fn connect<G: Boundaries>(
     }
     scratch.give(tmp);
     contribution
+}
+
+/// The hits of a connection's shadow walk, kept for its replay (a few: a
+/// connection crosses few media boundaries; past them the replay casts).
+#[derive(Default)]
+struct Recorded {
+    hits: [Option<Hit>; 8],
+    n: usize,
+}
+
+impl Recorded {
+    /// Casts and keeps the hit.
+    #[inline]
+    fn cast<G: Geometry>(&mut self, g: &G, x: G::V, w: G::V, skip: super::Prim) -> Option<Hit> {
+        let h = g.cast(x, w, skip);
+        if self.n < self.hits.len() {
+            self.hits[self.n] = h;
+            self.n += 1;
+        }
+        h
+    }
+
+    /// The `i`-th hit again (the replay's casts come in the same order with
+    /// the same rays), cast where none was kept.
+    #[inline]
+    fn replay<G: Geometry>(
+        &self,
+        i: &mut usize,
+        g: &G,
+        x: G::V,
+        w: G::V,
+        skip: super::Prim,
+    ) -> Option<Hit> {
+        let k = *i;
+        *i += 1;
+        if k < self.n {
+            self.hits[k]
+        } else {
+            g.cast(x, w, skip)
+        }
+    }
+
+    /// The first hit.
+    fn first(&self) -> Option<Hit> {
+        self.hits[0]
+    }
 }
 // ANCHOR_END: connect

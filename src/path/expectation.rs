@@ -38,9 +38,16 @@ pub struct Expectation<'a, G: Geometry> {
 /// Moves the direction `w` drawn at `v` with the warp: every slot's `η̇`,
 /// and the warp's divergence plus `∂ ln f` along it added to its score.
 #[inline]
-fn warp<G: Boundaries>(g: &G, slots: &Slots, d: &mut Deform<G::V>, v: &Vertex<G>, w: G::V) {
+fn warp<G: Boundaries>(
+    g: &G,
+    slots: &Slots,
+    d: &mut Deform<G::V>,
+    v: &Vertex<G>,
+    w: G::V,
+    ahead: Option<Option<Hit>>,
+) {
     let turning = frame_spins(g, slots, d, v, false);
-    let field = g.warp(v, w);
+    let field = g.warp(v, w, ahead);
     let mut involved = d.live.union(turning);
     g.warp_shapes(&field, |k| involved = involved.union(slots.moving(k)));
     for j in involved.iter() {
@@ -80,7 +87,7 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
         if let Some((v, drawn)) = self.pending.take() {
             debug_assert!(drawn == w, "the pending direction is the ray's");
             if !dead_end(g, hit) {
-                warp(g, self.slots, &mut self.d, &v, w);
+                warp(g, self.slots, &mut self.d, &v, w, Some(hit));
             }
         }
         self.d.segment(g, self.slots, false, x, w, hit);
@@ -122,7 +129,7 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
             v,
             false,
             true,
-            |d, w| warp(g, slots, d, v, w),
+            |d, w, ahead| warp(g, slots, d, v, w, ahead),
         )
     }
     #[inline]
@@ -130,7 +137,7 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
         let w = v.lobe.sample(rng);
         if !self.slots.is_empty() {
             if g.coefficients(v.medium).is_some() {
-                warp(g, self.slots, &mut self.d, v, w);
+                warp(g, self.slots, &mut self.d, v, w, None);
             } else {
                 self.pending = Some((*v, w));
             }

@@ -355,8 +355,11 @@ pub trait Boundaries: Geometry {
     /// discontinuity's velocity at the discontinuity and the frame's at the
     /// lobe's horizon, so no boundary term is left.
     type Warp;
-    /// The warp at `v` around the direction `w` drawn there.
-    fn warp(&self, v: &walk::Vertex<Self>, w: Self::V) -> Self::Warp
+    /// The warp at `v` around the direction `w` drawn there. `ahead`, when
+    /// the caller has cast the ray already, is its first hit (`Some(None)`:
+    /// it escapes); a geometry whose search starts from that hit then need
+    /// not cast it again.
+    fn warp(&self, v: &walk::Vertex<Self>, w: Self::V, ahead: Option<Option<Hit>>) -> Self::Warp
     where
         Self: Sized;
     /// Calls `f` with every shape whose motion the warp at `w` follows.

@@ -297,7 +297,7 @@ pub(super) fn attached_connect<G: Boundaries>(
     frozen: bool,
 ) -> f64 {
     let turning = frame_spins(g, slots, d, v, frozen);
-    connect(g, slots, scratch, d, rng, v, frozen, false, |d, w| {
+    connect(g, slots, scratch, d, rng, v, frozen, false, |d, w, _| {
         attach(d, slots.all(), turning, w)
     })
 }

@@ -214,15 +214,34 @@ pub fn light_sample<G: Geometry>(
 pub fn transmittance<G: Geometry, H: Hooks<G>>(
     g: &G,
     hooks: &mut H,
+    x: G::V,
+    w: G::V,
+    medium: MediumId,
+    skip: Prim,
+    target: Prim,
+) -> f64 {
+    transmittance_by(g, hooks, x, w, medium, skip, target, |x, w, skip| {
+        g.cast(x, w, skip)
+    })
+}
+
+/// [`transmittance`] with its rays cast by `cast` (a connection replays the
+/// hits of its shadow walk).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn transmittance_by<G: Geometry, H: Hooks<G>>(
+    g: &G,
+    hooks: &mut H,
     mut x: G::V,
     w: G::V,
     mut medium: MediumId,
     mut skip: Prim,
     target: Prim,
+    mut cast: impl FnMut(G::V, G::V, Prim) -> Option<Hit>,
 ) -> f64 {
     let mut tau = 0.0;
     loop {
-        let Some(h) = g.cast(x, w, skip) else {
+        let Some(h) = cast(x, w, skip) else {
             return 0.0;
         };
         hooks.boundary(g, x, w, Some(h));

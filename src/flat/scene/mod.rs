@@ -7,7 +7,7 @@
 //! This file holds the data types and the validated [`Scene`] with its
 //! accessors; `validate` builds a scene step by step and `repr` holds the
 //! file forms of the tagged enums.
-use super::corners::CornerGrid;
+use super::corners::CornerTree;
 use super::geometry::{NO_SEGMENT, RayCast, Segment, perp};
 use crate::error::Error;
 use glam::DVec2;
@@ -243,7 +243,7 @@ pub struct Scene {
     opaque_segments: Vec<Segment>,
     opaque_owner: Vec<u32>,
     /// The corners bucketed for triangle queries (many corners only).
-    corner_grid: Option<CornerGrid>,
+    corner_tree: Option<CornerTree>,
     /// Emitting segments with their cumulative length (for next-event
     /// estimation), and the total length.
     emitters: Vec<(u32, f64)>,
@@ -372,9 +372,9 @@ impl Scene {
             })
     }
     /// The corners bucketed for triangle queries, for scenes with more than
-    /// [`GRID_THRESHOLD`] corners.
-    pub fn corner_grid(&self) -> Option<&CornerGrid> {
-        self.corner_grid.as_ref()
+    /// [`CORNER_TREE_THRESHOLD`] corners.
+    pub fn corner_tree(&self) -> Option<&CornerTree> {
+        self.corner_tree.as_ref()
     }
     /// A point drawn uniformly (by length) on the emitting segments from a
     /// uniform number `u ∈ [0, 1)`: the point, its segment; `None` without
@@ -418,8 +418,8 @@ impl Scene {
     }
 }
 
-/// Most corners the warp scans one by one; above, a [`CornerGrid`].
-pub const GRID_THRESHOLD: usize = 64;
+/// Most corners the warp scans one by one; above, a [`CornerTree`].
+pub const CORNER_TREE_THRESHOLD: usize = 64;
 
 /// Most segments a scene traces by linear scan; above, a BVH.
 pub const BVH_THRESHOLD: usize = 24;

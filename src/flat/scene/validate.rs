@@ -5,11 +5,11 @@
 //! parameters, sensor, media), so a scene with several faults always reports
 //! the first of them.
 use super::{
-    BVH_THRESHOLD, GRID_THRESHOLD, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion,
+    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion,
     Parameter, Phase, Scene, Sensor, Shape, Surface, config,
 };
 use crate::error::{Error, Num};
-use crate::flat::corners::CornerGrid;
+use crate::flat::corners::CornerTree;
 use crate::flat::geometry::{
     LinearScan, NO_SEGMENT, RayCast, Segment, contains, cross, signed_area,
 };
@@ -41,8 +41,8 @@ impl Scene {
         let (parent, sensor_medium) = nest_media(&shapes, sensor.point());
         let opaque = Opaque::new(&shapes, &segments, &owner);
         let corners = corners(&shapes);
-        let corner_grid = (corners.len() > GRID_THRESHOLD)
-            .then(|| CornerGrid::new(&corners.iter().map(|c| c.0).collect::<Vec<_>>()));
+        let corner_tree = (corners.len() > CORNER_TREE_THRESHOLD)
+            .then(|| CornerTree::new(&corners.iter().map(|c| c.0).collect::<Vec<_>>()));
         let (emitters, emitter_length) = emitters(&shapes, &segments, &owner);
         Ok(Scene {
             emitters,
@@ -52,7 +52,7 @@ impl Scene {
             opaque_index: opaque.index,
             opaque_segments: opaque.segments,
             opaque_owner: opaque.owner,
-            corner_grid,
+            corner_tree,
             corners,
             shapes,
             parameters,
