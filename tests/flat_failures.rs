@@ -25,30 +25,29 @@ fn aligned_corners(gap: f64) -> Arc<Scene> {
 }
 
 #[test]
-fn expectation_variance_grows_as_two_warp_knots_meet() {
-    // Between two knots a radian apart the warp's slope is the difference of
-    // their velocities over their distance: its square integrates to ~1/gap.
+fn expectation_variance_stays_bounded_as_two_warp_knots_meet_at_the_sensor() {
+    // Between two knots the warp's slope is the difference of their
+    // velocities over their distance: drawn by the cosine lobe alone its
+    // square integrates to ~1/gap (σ²N grew 20× from gap 0.1 to 1e-3).
+    // The sensor's direction density gives such a steep gap its own share
+    // of the draws (flat::sensor_gaps), so the variance stays bounded as
+    // the corners meet, and the estimate stays on the closed form.
     let paths = 400_000;
     let mut per_path = Vec::new();
-    for gap in [0.1, 1e-3] {
+    for gap in [0.1, 1e-3, 1e-6] {
         let scene = aligned_corners(gap);
         let exact = Reference::for_scene(&scene).unwrap().derivative(0);
         let (e, ve) = sensitivity(Method::Expectation, &scene, paths);
         let (r, vr) = sensitivity(Method::Rendering, &scene, paths);
         assert!(r.z_score(exact) < 4.0, "rendering {r:?} vs {exact}");
-        per_path.push((ve, vr, e, exact));
+        assert!(e.z_score(exact) < 4.0, "expectation at {gap}: {e:?} vs {exact}");
+        per_path.push((ve, vr));
     }
-    let (ve_far, vr_far, e_far, exact_far) = per_path[0];
-    let (ve_near, vr_near, _, _) = per_path[1];
-    assert!(e_far.z_score(exact_far) < 4.0, "{e_far:?} vs {exact_far}");
-    assert!(
-        ve_near > 20.0 * ve_far,
-        "expectation σ²N {ve_far:.3e} → {ve_near:.3e}"
-    );
-    assert!(
-        vr_near < 3.0 * vr_far,
-        "rendering σ²N {vr_far:.3e} → {vr_near:.3e}"
-    );
+    let (ve_far, vr_far) = per_path[0];
+    for &(ve, vr) in &per_path[1..] {
+        assert!(ve < 3.0 * ve_far, "expectation σ²N {ve_far:.3e} → {ve:.3e}");
+        assert!(vr < 3.0 * vr_far, "rendering σ²N {vr_far:.3e} → {vr:.3e}");
+    }
 }
 
 /// A sensor inside a moving absorbing box, `d` from its left edge (the

@@ -486,6 +486,7 @@ pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
         frame: crate::path::walk::Frame::Sensor,
         beta: 1.0,
         at_sensor,
+        mixed: false,
     };
     let field = plane.warp(&v, w, None);
     (0..n)

@@ -13,6 +13,7 @@ pub mod geometry;
 pub mod lobe;
 pub mod methods;
 pub mod scene;
+pub mod sensor_gaps;
 pub mod space;
 
 pub use methods::Method;

@@ -35,6 +35,9 @@ pub struct Plane {
     /// angle from +x: the warp's knots there, the same for every path
     /// (found on first use: only the expectation method asks).
     sensor_knots: OnceLock<Vec<Knot>>,
+    /// The expectation method's direction density at that sensor
+    /// ([`super::sensor_gaps`]; found on first use).
+    sensor_gaps: OnceLock<super::sensor_gaps::SensorGaps>,
     /// A line camera's corners (see [`Plane::camera_corner_list`]).
     camera_corners: OnceLock<Vec<(f64, u32)>>,
 }
@@ -133,6 +136,7 @@ impl Plane {
             all_cdf,
             moving_cdf,
             sensor_knots: OnceLock::new(),
+            sensor_gaps: OnceLock::new(),
             camera_corners: OnceLock::new(),
         }
     }
@@ -183,6 +187,12 @@ impl Plane {
             list.sort_by(|a, b| a.0.total_cmp(&b.0));
             list
         })
+    }
+
+    /// The expectation method's direction density at the irradiance sensor.
+    pub(super) fn sensor_gaps(&self) -> &super::sensor_gaps::SensorGaps {
+        self.sensor_gaps
+            .get_or_init(|| super::sensor_gaps::SensorGaps::new(self))
     }
 
     /// The warp's knots at an irradiance sensor (see the field).
@@ -333,6 +343,17 @@ impl Geometry for Plane {
     #[inline]
     fn velocity(&self, j: usize, q: DVec2) -> DVec2 {
         self.scene.parameters()[j].motion.velocity(q)
+    }
+    fn sensor_mixture(&self) -> bool {
+        self.sensor_gaps().share > 0.0
+    }
+    #[inline]
+    fn sensor_mixture_sample(&self, lobe: &FlatLobe, rng: &mut PathRng) -> DVec2 {
+        self.sensor_gaps().sample(lobe, rng)
+    }
+    #[inline]
+    fn sensor_mixture_pdf(&self, _lobe: &FlatLobe, w: DVec2) -> f64 {
+        self.sensor_gaps().pdf(w)
     }
     #[inline]
     fn spin(&self, j: usize) -> f64 {

@@ -45,6 +45,7 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
                 // irradiance sensor only. (3D's sensor view serves any
                 // vertex at the sensor's point, the pinhole included.)
                 at_sensor: false,
+                mixed: false,
             };
             let w = hooks.scatter(g, rng, &v);
             let scale = lobe.weight();
@@ -61,6 +62,7 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
             let lobe = g.cosine_lobe(normal, 1.0);
             // The walk carries the lobe's weight outside, so Russian
             // roulette sees the same throughput as the radiance's.
+            let mixed = H::SENSOR_MIXTURE && g.sensor_mixture();
             let v = Vertex {
                 x: point,
                 medium,
@@ -70,6 +72,7 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
                 frame: Frame::Sensor,
                 beta: 1.0,
                 at_sensor: true,
+                mixed,
             };
             let direct = if H::NEXT_EVENT {
                 hooks.connect(g, rng, &v)
@@ -77,10 +80,18 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
                 0.0
             };
             let w = hooks.scatter(g, rng, &v);
-            let drawn = H::NEXT_EVENT.then(|| (lobe.pdf(w), point));
+            // Drawn with the sensor's own density `q`, the path carries
+            // `p/q` (the lobe's weight `f/p` stays outside, in `scale`).
+            let (q, beta) = if mixed {
+                let q = g.sensor_mixture_pdf(&lobe, w);
+                (q, lobe.pdf(w) / q)
+            } else {
+                (lobe.pdf(w), 1.0)
+            };
+            let drawn = H::NEXT_EVENT.then_some((q, point));
             let scale = lobe.weight();
             (
-                scale * (direct + walk(g, hooks, rng, point, w, medium, NO_PRIM, 1.0, drawn)),
+                scale * (direct + walk(g, hooks, rng, point, w, medium, NO_PRIM, beta, drawn)),
                 scale,
             )
         }

@@ -80,6 +80,9 @@ fn dead_end<G: Geometry>(g: &G, hit: Option<Hit>) -> bool {
 }
 
 impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
+    // The warp's steep gaps at the sensor get their own share of the draws.
+    const SENSOR_MIXTURE: bool = true;
+
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
         // The warp of a direction drawn in vacuum, now that its hit is known
@@ -134,7 +137,11 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     }
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
-        let w = v.lobe.sample(rng);
+        let w = if v.mixed {
+            g.sensor_mixture_sample(&v.lobe, rng)
+        } else {
+            v.lobe.sample(rng)
+        };
         if !self.slots.is_empty() {
             if g.coefficients(v.medium).is_some() {
                 warp(g, self.slots, &mut self.d, v, w, None);

@@ -293,6 +293,21 @@ pub trait Geometry: Sync {
     fn velocity(&self, j: usize, q: Self::V) -> Self::V;
     /// Turn rate of that shape's frame under parameter `j`.
     fn spin(&self, j: usize) -> <Self::V as Vector>::Spin;
+    /// Whether the geometry offers its own direction density at the
+    /// irradiance sensor for the methods that ask for one
+    /// ([`walk::Hooks::SENSOR_MIXTURE`]; flatland: the lobe mixed with the
+    /// warp's steep gaps, [`crate::flat::sensor_gaps`]).
+    fn sensor_mixture(&self) -> bool {
+        false
+    }
+    /// A direction drawn at the sensor with that density.
+    fn sensor_mixture_sample(&self, lobe: &Self::Lobe, rng: &mut PathRng) -> Self::V {
+        lobe.sample(rng)
+    }
+    /// That density at `w`.
+    fn sensor_mixture_pdf(&self, lobe: &Self::Lobe, w: Self::V) -> f64 {
+        lobe.pdf(w)
+    }
 }
 
 /// A discontinuity of the integrand over directions seen from a vertex,

@@ -69,6 +69,9 @@ pub struct Vertex<G: Geometry> {
     pub beta: f64,
     /// Whether this is the irradiance sensor (whose warp knots are known).
     pub at_sensor: bool,
+    /// Whether directions here are drawn with the geometry's sensor density
+    /// ([`Geometry::sensor_mixture`]) rather than the lobe's.
+    pub mixed: bool,
 }
 
 // By hand: a derive would ask `G: Copy` of the geometry itself.
@@ -90,6 +93,11 @@ pub trait Hooks<G: Geometry> {
     /// estimation with MIS); without, lamps count only when hit (plain path
     /// tracing, the reference the tests check next-event estimation with).
     const NEXT_EVENT: bool = true;
+    /// Whether the irradiance sensor draws its directions with the
+    /// geometry's own density where it has one
+    /// ([`Geometry::sensor_mixture`]); the hooks' `scatter` then draws with
+    /// it at a vertex marked `mixed`.
+    const SENSOR_MIXTURE: bool = false;
     /// A segment from `x` along `w` ends at `hit` (`None`: it escapes).
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {}
@@ -203,7 +211,13 @@ pub fn light_sample<G: Geometry>(
     let Surface::Emitter { radiance } = g.surface(p) else {
         return None;
     };
-    Some((w, p, v.beta * (f * radiance / p_light * mis(p_light, f))))
+    // Weighed against the density the vertex draws its directions with.
+    let drawn = if v.mixed {
+        g.sensor_mixture_pdf(&v.lobe, w)
+    } else {
+        f
+    };
+    Some((w, p, v.beta * (f * radiance / p_light * mis(p_light, drawn))))
 }
 
 /// The transmittance along `w` from `x` (in `medium`, leaving `skip`) to
@@ -318,6 +332,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                     frame: Frame::Incoming,
                     beta,
                     at_sensor: false,
+                    mixed: false,
                 };
                 if H::NEXT_EVENT {
                     total += hooks.connect(g, rng, &v);
@@ -374,6 +389,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                     frame: Frame::Surface(k),
                     beta,
                     at_sensor: false,
+                    mixed: false,
                 };
                 hooks.reflect(g, rng, &leg, &v, k);
                 if H::NEXT_EVENT {
@@ -417,6 +433,7 @@ pub fn surface_radiance<G: Geometry>(
                 frame: Frame::Surface(g.shape(p)),
                 beta: lobe.weight(),
                 at_sensor: false,
+                mixed: false,
             };
             let direct = next_event(g, rng, &v);
             let wo = lobe.sample(rng);
