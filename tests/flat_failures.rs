@@ -40,7 +40,10 @@ fn expectation_variance_stays_bounded_as_two_warp_knots_meet_at_the_sensor() {
         let (e, ve) = sensitivity(Method::Expectation, &scene, paths);
         let (r, vr) = sensitivity(Method::Rendering, &scene, paths);
         assert!(r.z_score(exact) < 4.0, "rendering {r:?} vs {exact}");
-        assert!(e.z_score(exact) < 4.0, "expectation at {gap}: {e:?} vs {exact}");
+        assert!(
+            e.z_score(exact) < 4.0,
+            "expectation at {gap}: {e:?} vs {exact}"
+        );
         per_path.push((ve, vr));
     }
     let (ve_far, vr_far) = per_path[0];

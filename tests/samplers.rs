@@ -609,6 +609,7 @@ fn corners_are_drawn_by_weight() {
             w_in: DVec2::ZERO,
             beta: 1.0,
             at_sensor: false,
+            mixed: false,
         };
         for _ in 0..N {
             let b = plane.sample_boundary(&v, all, rng.random()).unwrap();

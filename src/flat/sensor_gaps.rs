@@ -163,7 +163,10 @@ impl SensorGaps {
         if u >= self.share {
             return lobe.sample(rng);
         }
-        let i = self.cdf.partition_point(|&c| c <= u).min(self.cdf.len() - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.cdf.len() - 1);
         let psi = self.start[i] + self.width[i] * rng.random::<f64>();
         DVec2::from_angle(psi).rotate(self.n)
     }
@@ -234,7 +237,10 @@ mod tests {
         for _ in 0..n {
             let d = g.sample(&lobe, &mut rng);
             let psi = cross(g.n, d).atan2(g.n.dot(d));
-            let i = edges.partition_point(|&e| e <= psi).clamp(1, edges.len() - 1) - 1;
+            let i = edges
+                .partition_point(|&e| e <= psi)
+                .clamp(1, edges.len() - 1)
+                - 1;
             counts[i] += 1;
         }
         for (i, &c) in counts.iter().enumerate() {

@@ -217,7 +217,11 @@ pub fn light_sample<G: Geometry>(
     } else {
         f
     };
-    Some((w, p, v.beta * (f * radiance / p_light * mis(p_light, drawn))))
+    Some((
+        w,
+        p,
+        v.beta * (f * radiance / p_light * mis(p_light, drawn)),
+    ))
 }
 
 /// The transmittance along `w` from `x` (in `medium`, leaving `skip`) to
