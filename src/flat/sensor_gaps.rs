@@ -15,14 +15,15 @@
 //!
 //! The density `q = (1 − B) p + Σ_i β_i 𝟙_i / g_i` bounds it: the gap's
 //! second moment becomes `f² Δα² / (ℓ_i + β_i)`, `ℓ_i = (1 − B) p g_i` the
-//! lobe's share of the gap. Minimising `Σ c_i / (ℓ_i + β_i)` over `β ≥ 0`
-//! with `c_i = f_i² Δα_i²` gives `ℓ_i + β_i ∝ f_i Δα_i` where that exceeds
-//! `ℓ_i` (water-filling): we take `f ≈ p` (the lobe's value is its density
-//! up to a constant), and `Δα_i = (Σ_j (Δα_ij / S_j)²)^½` with `S_j = ∫ p |α_j|`
-//! the slot's own scale, and `β_i = max(0, κ p_i Δα_i − ℓ_i)` with the slope
-//! threshold `κ` fixed ([`STEEP`]); the total share `B = Σ β_i` is capped
-//! at [`MAX_SHARE`] (all `β` scaled down together). A scene with no steep gap
-//! gets `B = 0`: the lobe alone, bit for bit as before.
+//! lobe's share of the gap, at most `f² Δα² / β_i` whatever `g_i`. With
+//! every slot's jump measured in its largest knot rate `A_j`,
+//! `D_i = Σ_j (Δα_ij / A_j)²`, and `f ≈ p` (the lobe's value is its density
+//! up to a constant), a gap is steep where the lobe alone would give it a
+//! second moment `p D_i / g_i` above ten times a typical `M` (2 per slot),
+//! and then gets `β_i = p² D_i / M`, the share that brings it down to `M`;
+//! the total `B = Σ β_i` is capped at [`MAX_SHARE`] (all `β` scaled down
+//! together). A scene with no steep gap gets `B = 0`: the lobe alone, bit
+//! for bit as before.
 //!
 //! The density is fixed at the scene's `π₀`: the derivative is taken at
 //! `π₀`, so `q` enters only as the weight `f/q` of the sample, never the

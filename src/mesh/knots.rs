@@ -52,11 +52,12 @@ impl Space {
         let edges = &tables.edges;
         let (tree, list, visible) = if at_sensor {
             let view = self.sensor_view();
-            (
-                &view.tree,
-                (view.edges.len() <= super::sensor_view::SCAN).then_some(&view.edges),
-                view.visible.as_ref(),
-            )
+            // The fibre's azimuth bin, where the pole is one of the view's.
+            let list = match view.fibres(p) {
+                Some(f) => Some(f.candidates(u)),
+                None => (view.edges.len() <= super::sensor_view::SCAN).then_some(&view.edges[..]),
+            };
+            (&view.tree, list, view.visible.as_ref())
         } else {
             (&tables.all_edges, None, None)
         };

@@ -45,6 +45,118 @@ pub struct SensorView {
     pub tree: EdgeTree,
     /// Their visible parts, if computed.
     pub visible: Option<Visible>,
+    /// Per pole the warp uses at the point (fixed there: the scene's pole
+    /// rules, a camera's right and up), the edges each fibre can cut.
+    pub fibres: Vec<AzimuthBuckets>,
+}
+
+/// Azimuth bins around a fixed pole `p` at the sensor's point: the fibres
+/// (half great circles from `p`) of one bin can only cut the edges listed
+/// for it, so a fibre's knot search scans a few edges, not the ring.
+///
+/// Why this is exact: the fibre at azimuth `φ` is the half-plane through
+/// the point bounded by the pole's line; it cuts an edge exactly when the
+/// edge's projection on the plane across `p` crosses the ray at `φ`, that
+/// is when `φ` lies on the short arc between its ends' azimuths (a segment
+/// that does not pass through the origin subtends less than π). Each edge
+/// is listed in every bin that arc meets, with a bin to spare on either
+/// side against rounding; an edge passing (within rounding) through the
+/// pole's line is listed everywhere.
+#[derive(Debug, Clone, Default)]
+pub struct AzimuthBuckets {
+    /// The pole, and two unit vectors across it.
+    pub p: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+    /// `items[start[b]..start[b + 1]]`: the edges of bin `b`.
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+/// Azimuth bins per pole.
+const BINS: usize = 256;
+
+/// A monotone stand-in for the angle of `(x, y)`, in `[0, 4)` (the
+/// "diamond angle": a quarter turn per unit, antipodes 2 apart).
+#[inline]
+fn diamond(x: f64, y: f64) -> f64 {
+    let a = if y >= 0.0 {
+        if x >= 0.0 {
+            y / (x + y)
+        } else {
+            1.0 - x / (y - x)
+        }
+    } else if x < 0.0 {
+        2.0 - y / (-x - y)
+    } else {
+        3.0 + x / (x - y)
+    };
+    if a.is_finite() {
+        a.rem_euclid(4.0)
+    } else {
+        0.0
+    }
+}
+
+impl AzimuthBuckets {
+    /// The bins around `p` at `s` for the edges `seen`.
+    pub fn new(s: DVec3, p: DVec3, edges: &[Edge], seen: &[u32]) -> AzimuthBuckets {
+        let (e1, e2) = p.any_orthonormal_pair();
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); BINS];
+        let bin = |a: f64| ((a * BINS as f64 / 4.0) as usize).min(BINS - 1);
+        for &i in seen {
+            let e = &edges[i as usize];
+            let (a, b) = (e.a - s, e.b - s);
+            let (ax, ay, bx, by) = (a.dot(e1), a.dot(e2), b.dot(e1), b.dot(e2));
+            // The projection's distance to the origin, against its size.
+            let (dx, dy) = (bx - ax, by - ay);
+            let len2 = dx * dx + dy * dy;
+            let t = if len2 > 0.0 {
+                (-(ax * dx + ay * dy) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let (cx, cy) = (ax + t * dx, ay + t * dy);
+            let size = (ax.hypot(ay)).max(bx.hypot(by));
+            if cx.hypot(cy) <= 1e-9 * size || size == 0.0 {
+                lists.iter_mut().for_each(|l| l.push(i));
+                continue;
+            }
+            let (pa, pb) = (diamond(ax, ay), diamond(bx, by));
+            let (from, to) = if (pb - pa).rem_euclid(4.0) <= 2.0 {
+                (pa, pb)
+            } else {
+                (pb, pa)
+            };
+            let (first, last) = (bin(from), bin(to));
+            let span = (last + BINS - first) % BINS;
+            for k in 0..=span + 2 {
+                lists[(first + BINS - 1 + k) % BINS].push(i);
+            }
+        }
+        let mut start = vec![0u32];
+        let mut items = Vec::new();
+        for l in &lists {
+            items.extend_from_slice(l);
+            start.push(items.len() as u32);
+        }
+        AzimuthBuckets {
+            p,
+            e1,
+            e2,
+            start,
+            items,
+        }
+    }
+
+    /// The edges the fibre through the unit direction `u` (across `p`) can
+    /// cut.
+    #[inline]
+    pub fn candidates(&self, u: DVec3) -> &[u32] {
+        let b =
+            ((diamond(u.dot(self.e1), u.dot(self.e2)) * BINS as f64 / 4.0) as usize).min(BINS - 1);
+        &self.items[self.start[b] as usize..self.start[b + 1] as usize]
+    }
 }
 
 /// The visible parts of some edges, as intervals of their parameter.
@@ -86,7 +198,30 @@ impl SensorView {
             tree: EdgeTree::new(edges, facts, weights, seen.clone()),
             edges: seen,
             visible,
+            fibres: Vec::new(),
         }
+    }
+}
+
+impl SensorView {
+    /// Adds the azimuth bins of the poles `poles` (skipped without visible
+    /// parts or beyond [`SCAN`] edges: the tree serves those).
+    pub fn with_fibres(mut self, edges: &[Edge], poles: impl IntoIterator<Item = DVec3>) -> Self {
+        if self.visible.is_some() && self.edges.len() <= SCAN {
+            for p in poles {
+                if !self.fibres.iter().any(|f| f.p == p) {
+                    self.fibres
+                        .push(AzimuthBuckets::new(self.point, p, edges, &self.edges));
+                }
+            }
+        }
+        self
+    }
+
+    /// The bins around the pole `p`, if built.
+    #[inline]
+    pub fn fibres(&self, p: DVec3) -> Option<&AzimuthBuckets> {
+        self.fibres.iter().find(|f| f.p == p)
     }
 }
 
@@ -256,5 +391,75 @@ mod tests {
             }
         }
         assert!(seen > 1000 && hidden > 1000, "{seen} {hidden}");
+    }
+
+    /// Every edge a fibre's half-plane cuts is among its bin's candidates:
+    /// random edges around the point (some passing over the pole's line,
+    /// some along the pole), random poles and fibres, against the plane
+    /// test itself.
+    #[test]
+    fn a_fibres_bin_holds_every_edge_it_cuts() {
+        let mut rng = crate::rng::PathRng::seed_from_u64(8);
+        let mut unit = || {
+            let z = 2.0 * rng.random::<f64>() - 1.0;
+            let phi = std::f64::consts::TAU * rng.random::<f64>();
+            let r = (1.0 - z * z).sqrt();
+            DVec3::new(r * phi.cos(), r * phi.sin(), z)
+        };
+        let s = DVec3::new(0.3, -0.1, 0.2);
+        let mut cut = 0;
+        for round in 0..20 {
+            let p = unit();
+            let mut edges: Vec<Edge> = (0..60)
+                .map(|_| {
+                    let a = s + unit() * 2.0;
+                    Edge {
+                        a,
+                        b: a + unit() * 1.5,
+                        faces: [0, crate::path::NO_PRIM],
+                        shape: 0,
+                    }
+                })
+                .collect();
+            // Through the pole's line, and along the pole.
+            let (c, d, v) = (s + p, unit() * 0.5, unit());
+            for (a, b) in [(c + d, c - d), (s + v + p * 0.2, s + v + p * 0.7)] {
+                edges.push(Edge {
+                    a,
+                    b,
+                    faces: [0, crate::path::NO_PRIM],
+                    shape: 0,
+                });
+            }
+            let seen: Vec<u32> = (0..edges.len() as u32).collect();
+            let bins = AzimuthBuckets::new(s, p, &edges, &seen);
+            for _ in 0..500 {
+                let w = unit();
+                let perp = w - p * w.dot(p);
+                if perp.length() < 1e-9 {
+                    continue;
+                }
+                let u = perp.normalize();
+                let m = p.cross(u);
+                let candidates = bins.candidates(u);
+                for (i, e) in edges.iter().enumerate() {
+                    let (sa, sb) = ((e.a - s).dot(m), (e.b - s).dot(m));
+                    if sa * sb >= 0.0 {
+                        continue;
+                    }
+                    let t = sa / (sa - sb);
+                    let q = e.a + (e.b - e.a) * t;
+                    if (q - s).dot(u) <= 0.0 {
+                        continue;
+                    }
+                    cut += 1;
+                    assert!(
+                        candidates.contains(&(i as u32)),
+                        "round {round}: edge {i} is cut by the fibre {u} but not listed"
+                    );
+                }
+            }
+        }
+        assert!(cut > 10_000, "{cut} cuts");
     }
 }

@@ -206,13 +206,14 @@ impl Space {
                 })
                 .map(|i| (i as Prim, self.tris[i]))
                 .collect();
-            SensorView::new(
-                self.scene.sensor().point(),
-                &t.edges,
-                &t.edge_facts,
-                &t.edge_weight,
-                &opaque,
-            )
+            let point = self.scene.sensor().point();
+            // The poles of the warp's fibres at the point: fixed there.
+            let mut poles: Vec<DVec3> = self.pole_rules.iter().map(|r| r.at(point)).collect();
+            if let Some(cam) = &self.camera {
+                poles.extend([cam.r, cam.u]);
+            }
+            SensorView::new(point, &t.edges, &t.edge_facts, &t.edge_weight, &opaque)
+                .with_fibres(&t.edges, poles)
         })
     }
 

@@ -102,7 +102,7 @@ impl PoleRule {
 
     /// The pole at `x`.
     #[inline]
-    fn at(&self, x: DVec3) -> DVec3 {
+    pub(super) fn at(&self, x: DVec3) -> DVec3 {
         match *self {
             PoleRule::Hashed => pole(x),
             PoleRule::Along(d) => d,
