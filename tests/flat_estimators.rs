@@ -228,8 +228,8 @@ fn a_steep_gap_before_a_reflecting_vault_matches_finite_differences() {
     // at the sensor (`flat::sensor_gaps`), and seen again from the vault.
     use geosens::flat::{Motion, Parameter, Shape, Surface};
     use glam::DVec2;
-    let base = file::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/occluder.toml"))
-        .unwrap();
+    let base =
+        file::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/occluder.toml")).unwrap();
     let (n, step) = (400, (std::f64::consts::PI - 0.2) / 400.0);
     let corner = 1.0f64.atan2(0.2) + 1e-4; // past the occluder's end (0.2, 1)
     let k = ((corner - 0.1) / step).round();
