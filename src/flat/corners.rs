@@ -249,12 +249,28 @@ mod tests {
             .collect();
         corners.extend((0..500).map(|i| DVec2::new(-1.0 + i as f64 / 250.0, 1.0)));
         corners.push(corners[17]); // a repeated corner
-        let tree = CornerTree::new(&corners);
+        for scale in [1.0, 1e-40, 1e40] {
+            let corners: Vec<DVec2> = corners.iter().map(|&c| c * scale).collect();
+            let checked = thin_triangles(&corners, &mut rng);
+            assert!(
+                checked > 1000,
+                "the triangles held {checked} corners at {scale}"
+            );
+        }
+    }
+
+    /// Brute force against the tree for 2000 thin triangles from a corner:
+    /// how many corners they held.
+    fn thin_triangles(corners: &[DVec2], rng: &mut rand_xoshiro::Xoshiro256PlusPlus) -> usize {
+        let tree = CornerTree::new(corners);
+        let size = corners
+            .iter()
+            .fold(0.0f64, |m, c| m.max(c.abs().max_element()));
         let mut checked = 0;
         for _ in 0..2000 {
             let a = corners[rng.random_range(0..corners.len())];
             let b = corners[rng.random_range(0..corners.len())];
-            let spread = [1e-3, 1e-1, 1.0][rng.random_range(0..3)];
+            let spread = [1e-3, 1e-1, 1.0][rng.random_range(0..3)] * size / 3.0;
             let c = b + DVec2::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5) * spread;
             let mut found = Vec::new();
             tree.near_triangle(a, b, c, |i| {
@@ -269,6 +285,6 @@ mod tests {
             checked += all.len();
             assert_eq!(found, all, "triangle {a} {b} {c}");
         }
-        assert!(checked > 1000, "the triangles held {checked} corners");
+        checked
     }
 }
