@@ -12,41 +12,11 @@
 //! run's time, per parameter and derivative method, with its ratio to the
 //! best (finite differences left out: they are biased).
 use geosens::flat::space::Plane;
-use geosens::flat::{Method, Motion, Parameter, Scene, Sensor, Shape, Surface, file};
+use geosens::flat::{Method, Scene, file};
 use geosens::path::intensity::PlainEstimator;
 use geosens::{Quantity, RunConfig, RunResult, run};
-use glam::DVec2;
 use std::path::Path;
 use std::sync::Arc;
-
-/// The occluder scene under a reflecting vault of `n` segments.
-fn vault(n: usize) -> Scene {
-    let base = file::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/occluder.toml"))
-        .expect("scenes/occluder.toml loads");
-    let mut shapes = base.shapes().to_vec();
-    let vertices = (0..=n)
-        .map(|i| {
-            let a = 0.1 + (std::f64::consts::PI - 0.2) * i as f64 / n as f64;
-            let r = 3.0 + 0.05 * (40.0 * a).sin();
-            DVec2::new(r * a.cos(), r * a.sin())
-        })
-        .collect();
-    shapes.push(Shape {
-        name: "vault".into(),
-        vertices,
-        closed: false,
-        surface: Surface::Reflector { albedo: 0.5 },
-        medium: None,
-    });
-    let mut parameters: Vec<Parameter> = base.parameters().to_vec();
-    parameters.push(Parameter {
-        name: "vault_ty".into(),
-        shape: "vault".into(),
-        motion: Motion::TranslateY,
-    });
-    let sensor: Sensor = base.sensor();
-    Scene::new(shapes, parameters, sensor).expect("the vault scene is valid")
-}
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -62,7 +32,10 @@ fn main() {
             "three_shapes".into(),
             Arc::new(file::load(&dir.join("three_shapes.toml")).unwrap()),
         ),
-        ("vault 10^4".into(), Arc::new(vault(10_000))),
+        (
+            "vault 10^4".into(),
+            Arc::new(geosens::flat::cases::vault(10_000, 0.0).expect("the vault scene is valid")),
+        ),
     ];
     let methods = [
         Method::Intensity,

@@ -226,40 +226,10 @@ fn a_steep_gap_before_a_reflecting_vault_matches_finite_differences() {
     // of whose corners the sensor sees 10⁻⁴ rad past the occluder's moving
     // end: a steep gap of the expectation method's warp, drawn on its own
     // at the sensor (`flat::sensor_gaps`), and seen again from the vault.
-    use geosens::flat::{Motion, Parameter, Shape, Surface};
-    use glam::DVec2;
-    let base =
-        file::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/occluder.toml")).unwrap();
-    let (n, step) = (400, (std::f64::consts::PI - 0.2) / 400.0);
+    let step = (std::f64::consts::PI - 0.2) / 400.0;
     let corner = 1.0f64.atan2(0.2) + 1e-4; // past the occluder's end (0.2, 1)
-    let k = ((corner - 0.1) / step).round();
-    let vertices = (0..=n)
-        .map(|i| {
-            let a = corner + (i as f64 - k) * step;
-            let r = 3.0 + 0.05 * (40.0 * a).sin();
-            DVec2::new(r * a.cos(), r * a.sin())
-        })
-        .collect();
-    let mut shapes = base.shapes().to_vec();
-    shapes.push(Shape {
-        name: "vault".into(),
-        vertices,
-        closed: false,
-        surface: Surface::Reflector { albedo: 0.5 },
-        medium: None,
-    });
-    let mut parameters: Vec<Parameter> = base
-        .parameters()
-        .iter()
-        .filter(|p| p.name == "occluder_tx" || p.name == "occluder_rotate")
-        .cloned()
-        .collect();
-    parameters.push(Parameter {
-        name: "vault_ty".into(),
-        shape: "vault".into(),
-        motion: Motion::TranslateY,
-    });
-    let scene = Arc::new(Scene::new(shapes, parameters, base.sensor()).unwrap());
+    let shift = corner - 0.1 - ((corner - 0.1) / step).round() * step;
+    let scene = Arc::new(geosens::flat::cases::vault(400, shift).unwrap());
     // The irradiance kinks each time the occluder's shadow on the vault
     // crosses a vault corner (about 0.008 apart): a small step keeps the
     // finite difference off the smoothed slope.

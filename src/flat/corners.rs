@@ -220,17 +220,7 @@ mod tests {
                 )
             };
             let (a, b, c) = (p(), p(), p());
-            let mut found = Vec::new();
-            grid.near_triangle(a, b, c, |i| {
-                if inside(a, b, c, corners[i as usize]) {
-                    found.push(i)
-                }
-            });
-            found.sort();
-            let all: Vec<u32> = (0..corners.len() as u32)
-                .filter(|&i| inside(a, b, c, corners[i as usize]))
-                .collect();
-            assert_eq!(found, all);
+            agrees_with_brute_force(&grid, &corners, [a, b, c]);
         }
     }
 
@@ -272,19 +262,29 @@ mod tests {
             let b = corners[rng.random_range(0..corners.len())];
             let spread = [1e-3, 1e-1, 1.0][rng.random_range(0..3)] * size / 3.0;
             let c = b + DVec2::new(rng.random::<f64>() - 0.5, rng.random::<f64>() - 0.5) * spread;
-            let mut found = Vec::new();
-            tree.near_triangle(a, b, c, |i| {
-                if inside(a, b, c, corners[i as usize]) {
-                    found.push(i)
-                }
-            });
-            found.sort();
-            let all: Vec<u32> = (0..corners.len() as u32)
-                .filter(|&i| inside(a, b, c, corners[i as usize]))
-                .collect();
-            checked += all.len();
-            assert_eq!(found, all, "triangle {a} {b} {c}");
+            checked += agrees_with_brute_force(&tree, corners, [a, b, c]);
         }
         checked
+    }
+
+    /// The corners the tree's query finds strictly inside the triangle are
+    /// those a scan finds; how many.
+    fn agrees_with_brute_force(
+        tree: &CornerTree,
+        corners: &[DVec2],
+        [a, b, c]: [DVec2; 3],
+    ) -> usize {
+        let mut found = Vec::new();
+        tree.near_triangle(a, b, c, |i| {
+            if inside(a, b, c, corners[i as usize]) {
+                found.push(i)
+            }
+        });
+        found.sort();
+        let all: Vec<u32> = (0..corners.len() as u32)
+            .filter(|&i| inside(a, b, c, corners[i as usize]))
+            .collect();
+        assert_eq!(found, all, "triangle {a} {b} {c}");
+        all.len()
     }
 }
