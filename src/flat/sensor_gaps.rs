@@ -154,6 +154,7 @@ impl SensorGaps {
         0.5 * w.dot(self.n).max(0.0)
     }
 
+    // ANCHOR: mixture
     /// A direction drawn with the mixture's density (the lobe is drawn as
     /// the lobe draws itself, after one uniform number picks the part).
     #[inline]
@@ -190,6 +191,7 @@ impl SensorGaps {
         let below = if i == 0 { 0.0 } else { self.cdf[i - 1] };
         lobe + (self.cdf[i] - below) / self.width[i]
     }
+    // ANCHOR_END: mixture
 }
 
 #[cfg(test)]
