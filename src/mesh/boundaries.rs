@@ -5,20 +5,30 @@
 //! crease (each side sees another face: a jump for a reflector only).
 //!
 //! The boundary term of the directional integral is a line integral along
-//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`, estimated by one point
-//! drawn from a defensive mixture of two strategies:
+//! those arcs, `∮ f (L_behind − L_ahead) v_n dl`, split in two by edge:
 //!
-//! - the edge hierarchy's ([`super::edges`]): an edge by weight, length ×
-//!   dihedral turn / π, among those that can be discontinuities from `x`,
-//!   then a point in angle along its arc (the same uniform number,
-//!   rescaled), half the time uniformly, half on the parts of the arc
-//!   behind which a lamp lies;
-//! - by lamp overlap (half the draws, when the hierarchy holds at most
-//!   `LAMP_EDGES` (64) edges and some silhouette from `x` has a lamp behind
-//!   part of its arc): an edge in proportion to the angle of those parts
-//!   over its distance, a point uniform on them. The hierarchy draws an
-//!   edge without a lamp behind as often as one with: where the jump
-//!   carries direct light those draws are wasted.
+//! - the lamps' edges (when the emitting meshes have at most `LAMP_SET`
+//!   (16)): each taken every time, one point per edge at the same
+//!   fraction of its arc ([`Space::lamp_edge_points`]). A vertex that
+//!   moves sees the lamp's outline move, and the jump there is the lamp's
+//!   whole radiance: the terms of opposite edges are large and nearly
+//!   cancel (a point turning with a rotating cube sees the whole outline
+//!   turn), so drawing one edge among them left their sum's variance, most
+//!   of the image's for the showcase's rotation;
+//! - every other edge, by one point drawn from a defensive mixture of two
+//!   strategies:
+//!
+//!   - the edge hierarchy's ([`super::edges`]): an edge by weight, length
+//!     × dihedral turn / π, among those that can be discontinuities from
+//!     `x`, then a point in angle along its arc (the same uniform number,
+//!     rescaled), half the time uniformly, half on the parts of the arc
+//!     behind which a lamp lies;
+//!   - by lamp overlap (half the draws, when the hierarchy holds at most
+//!     `LAMP_EDGES` (64) edges and some silhouette from `x` has a lamp
+//!     behind part of its arc): an edge in proportion to the angle of
+//!     those parts over its distance, a point uniform on them. The
+//!     hierarchy draws an edge without a lamp behind as often as one
+//!     with: where the jump carries direct light those draws are wasted.
 //!
 //! The density of the point, per unit arc length, is the mixture's at that
 //! point whichever strategy drew it: `(1 − s) p_tree(e) p(α | e) + s
@@ -28,14 +38,16 @@
 //! the path core's corner term (`rendering::corner_jump`) is, unchanged,
 //! the edge term.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
-use super::edges::{EdgeFacts, EdgeTree};
+use super::edges::{EdgeFacts, EdgeTree, is_discontinuity};
 use super::lobe::SpaceLobe;
 use super::space::Edge;
 use super::space::Space;
 use super::warp::SpaceWarp;
 use crate::path::walk::Vertex;
 use crate::path::{Boundaries, BoundaryPoint, NO_PRIM, Prim, Side};
+use crate::rng::PathRng;
 use glam::DVec3;
+use rand::RngExt;
 
 impl Space {
     /// The unit vector in the plane of face `p`, perpendicular to the edge
@@ -105,6 +117,20 @@ impl EdgeArc {
             t: n.cross(wa),
             arc,
         })
+    }
+}
+
+impl EdgeArc {
+    /// The point of `edge` (whose arc this is) seen at angle `alpha`
+    /// along the arc: where the ray along `wa cos α + t sin α` meets the
+    /// edge's line, in the plane through `x` and the edge.
+    #[inline]
+    fn point(&self, edge: &Edge, alpha: f64) -> DVec3 {
+        let (s, c) = alpha.sin_cos();
+        let w = self.wa * c + self.t * s;
+        let d = edge.b - edge.a;
+        let tau = (-(self.ra.cross(w).dot(self.n)) / d.cross(w).dot(self.n)).clamp(0.0, 1.0);
+        edge.a + d * tau
     }
 }
 
@@ -330,8 +356,9 @@ impl Space {
 
     // ANCHOR: edge_point
     /// A point on the edges that can be discontinuities seen from `x` (all
-    /// of them if `all`, else the moving meshes'), `inv_pdf` per unit arc
-    /// length on the sphere. Two strategies, the density the mixture's
+    /// of them if `all`, else the moving meshes'), but the lamp set's
+    /// ([`Space::lamp_edge_points`]), `inv_pdf` per unit arc length on the
+    /// sphere. Two strategies, the density the mixture's
     /// whichever drew the point:
     ///
     /// - the tree's: an edge drawn from the edge hierarchy, a point along
@@ -353,9 +380,9 @@ impl Space {
         let tables = self.edge_tables();
         let (edges, facts, weights) = (&tables.edges, &tables.edge_facts, &tables.edge_weight);
         let tree = if all {
-            &tables.all_edges
+            &tables.all_drawn
         } else {
-            &tables.moving_edges
+            &tables.moving_drawn
         };
         let ids = tree.edges();
         // At the sensor's point (a probe's every path starts there) the
@@ -432,12 +459,7 @@ impl Space {
         };
         let density = (1.0 - share) * by_tree + share * by_lamp;
         let edge = &edges[index as usize];
-        let (s, c) = alpha.sin_cos();
-        let w = arc.wa * c + arc.t * s;
-        // Where the ray along w meets the edge's line, in the plane (x, a, b).
-        let d = edge.b - edge.a;
-        let tau = (-(arc.ra.cross(w).dot(arc.n)) / d.cross(w).dot(arc.n)).clamp(0.0, 1.0);
-        let q = edge.a + d * tau;
+        let q = arc.point(edge, alpha);
         if !q.is_finite() || density.is_nan() || density <= 0.0 {
             return None;
         }
@@ -449,6 +471,41 @@ impl Space {
         })
     }
     // ANCHOR_END: edge_point
+
+    /// Calls `f` with one point on each lamp edge (of the lamp set,
+    /// [`EdgeTables::lamp_set`](super::space::EdgeTables)) that can be a
+    /// discontinuity seen from `x` (all of them if `all`, else the moving
+    /// lamps'), every point at the same fraction `u` of its edge's arc in
+    /// angle: density `1/arc` per unit arc length, each edge taken with
+    /// probability 1. [`Space::edge_point`] draws among the other edges.
+    #[inline]
+    fn lamp_edge_points(
+        &self,
+        x: DVec3,
+        all: bool,
+        u: f64,
+        mut f: impl FnMut(BoundaryPoint<DVec3>),
+    ) {
+        let tables = self.edge_tables();
+        for &e in &tables.lamp_set[all as usize] {
+            let edge = &tables.edges[e as usize];
+            if !is_discontinuity(edge, &tables.edge_facts[e as usize], x) {
+                continue;
+            }
+            let Some(arc) = EdgeArc::new(edge, x) else {
+                continue;
+            };
+            let q = arc.point(edge, u * arc.arc);
+            if q.is_finite() {
+                f(BoundaryPoint {
+                    q,
+                    shape: edge.shape,
+                    index: e,
+                    inv_pdf: arc.arc,
+                });
+            }
+        }
+    }
 }
 
 impl Boundaries for Space {
@@ -467,6 +524,25 @@ impl Boundaries for Space {
         self.edge_point(v.x, all, u)
     }
     // ANCHOR_END: sample_boundary
+
+    /// The lamps' edges ([`Space::lamp_edge_points`]), but at a camera
+    /// pixel (whose draws take every moving edge it sees).
+    #[inline]
+    fn boundary_set(
+        &self,
+        v: &Vertex<Self>,
+        all: bool,
+        rng: &mut PathRng,
+        mut f: impl FnMut(&mut PathRng, BoundaryPoint<DVec3>),
+    ) {
+        if matches!(v.lobe, SpaceLobe::Pixel { .. })
+            || self.edge_tables().lamp_set[all as usize].is_empty()
+        {
+            return;
+        }
+        let u: f64 = rng.random();
+        self.lamp_edge_points(v.x, all, u, |b| f(rng, b));
+    }
 
     // ANCHOR: sides
     /// The faces at the edge on either side of the sight line `η` from `x`:

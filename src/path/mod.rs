@@ -335,6 +335,24 @@ pub trait Boundaries: Geometry {
     ) -> Option<BoundaryPoint<Self::V>>
     where
         Self: Sized;
+    /// Calls `f` with the boundary points the directional integral at `v`
+    /// takes every time besides the one drawn: one point on each of a few
+    /// boundaries that [`Boundaries::sample_boundary`] never draws (3D: the
+    /// lamps' edges), placed along them with numbers from `rng` (drawn only
+    /// if there are such boundaries), each `inv_pdf` its density's
+    /// inverse; `f` gets `rng` back to evaluate the term. None by default.
+    #[inline]
+    fn boundary_set(
+        &self,
+        v: &walk::Vertex<Self>,
+        all: bool,
+        rng: &mut crate::rng::PathRng,
+        f: impl FnMut(&mut crate::rng::PathRng, BoundaryPoint<Self::V>),
+    ) where
+        Self: Sized,
+    {
+        let _ = (v, all, rng, f);
+    }
     /// What rays just to either side of the direction from `x` to the
     /// boundary point see there: first the side
     /// [`Boundaries::boundary_normal`] points to (plane: counter-clockwise),

@@ -20,7 +20,7 @@
 //! "Rendering" and "Corner jumps".
 use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
 use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance};
-use super::{Boundaries, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface, Vector};
+use super::{Boundaries, BoundaryPoint, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface, Vector};
 use crate::rng::PathRng;
 use rand::RngExt;
 
@@ -163,9 +163,28 @@ pub(super) fn corner_jump<G: Boundaries>(
     if !all && frozen {
         return;
     }
-    let Some(b) = g.sample_boundary(v, all, rng.random()) else {
-        return;
-    };
+    // The drawn point, then the set taken every time.
+    if let Some(b) = g.sample_boundary(v, all, rng.random()) {
+        corner_term(g, slots, d, rng, v, frozen, moving_view, &b);
+    }
+    g.boundary_set(v, all, rng, |rng, b| {
+        corner_term(g, slots, d, rng, v, frozen, moving_view, &b)
+    });
+}
+
+/// The term of one boundary point `b` seen from `v` ([`corner_jump`]).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn corner_term<G: Boundaries>(
+    g: &G,
+    slots: &Slots,
+    d: &mut Deform<G::V>,
+    rng: &mut PathRng,
+    v: &Vertex<G>,
+    frozen: bool,
+    moving_view: SlotSet,
+    b: &BoundaryPoint<G::V>,
+) {
     let r = b.q - v.x;
     let dist = r.length();
     let wq = r * (1.0 / dist);
@@ -176,7 +195,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     let Some((t, medium)) = reach(g, v.x, b.q, v.medium, v.skip) else {
         return;
     };
-    let normal = g.boundary_normal(v.x, &b);
+    let normal = g.boundary_normal(v.x, b);
     let mut any = false;
     let involved = moving_view.union(movers(slots, b.shape, frozen));
     for j in involved.iter() {
@@ -195,9 +214,9 @@ pub(super) fn corner_jump<G: Boundaries>(
     if !any {
         return;
     }
-    let (ahead, behind) = g.sides(v.x, &b);
+    let (ahead, behind) = g.sides(v.x, b);
     let side = |rng: &mut PathRng, side: Side| match side {
-        Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(&b, p), p, wq, medium),
+        Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(b, p), p, wq, medium),
         Side::Past => radiance(g, rng, b.q, wq, medium, NO_PRIM),
     };
     let reflector = |s: Side| match s {
@@ -212,7 +231,7 @@ pub(super) fn corner_jump<G: Boundaries>(
         // costs more than the shared draws save (measured: a 125° concave
         // corner had rendering's variance four times larger).
         (Some(pa), Some(pb)) => {
-            let (ya, yb) = (g.off_boundary(&b, pa), g.off_boundary(&b, pb));
+            let (ya, yb) = (g.off_boundary(b, pa), g.off_boundary(b, pb));
             let facing = |p: Prim, y: G::V| {
                 let n = g.normal(p, y);
                 if wq.dot(n) > 0.0 { -n } else { n }
