@@ -79,10 +79,6 @@ const LAMP_TRIANGLES: usize = 16;
 /// per draw); larger trees draw by the tree alone.
 pub(super) const LAMP_EDGES: usize = 64;
 
-/// The share of the draws by lamp overlap at a vertex where some edge has
-/// a lamp behind part of its arc.
-const LAMP_SHARE: f64 = 0.5;
-
 /// An edge's arc seen from `x`: the directions `wa cos α + t sin α`,
 /// `α ∈ [0, arc]`, in the plane through `x` and the edge (unit normal `n`).
 #[derive(Debug, Clone, Copy)]
@@ -161,6 +157,51 @@ impl LampParts {
             left -= len;
         }
         (pick.0 + left.min(pick.1 - pick.0)).clamp(0.0, arc)
+    }
+
+    /// An angle uniform on `[0, arc]` outside every part for `v ∈ [0,
+    /// 1)`, and the angle outside them (the density is its inverse); `None`
+    /// if the parts cover the arc.
+    #[inline]
+    fn pick_outside(&self, v: f64, arc: f64) -> Option<(f64, f64)> {
+        // The parts merged: sorted by their start (insertion sort, at most
+        // LAMP_TRIANGLES), overlaps joined.
+        let mut iv = self.intervals;
+        let n = self.count;
+        for i in 1..n {
+            let mut j = i;
+            while j > 0 && iv[j - 1].0 > iv[j].0 {
+                iv.swap(j - 1, j);
+                j -= 1;
+            }
+        }
+        let mut merged = [(0.0, 0.0); LAMP_TRIANGLES];
+        let mut m = 0;
+        for &(lo, hi) in &iv[..n] {
+            if m > 0 && lo <= merged[m - 1].1 {
+                merged[m - 1].1 = merged[m - 1].1.max(hi);
+            } else {
+                merged[m] = (lo, hi);
+                m += 1;
+            }
+        }
+        let covered: f64 = merged[..m].iter().map(|(lo, hi)| hi - lo).sum();
+        let outside = arc - covered;
+        if outside <= 0.0 {
+            return None;
+        }
+        // The gaps, in order: before the first part, between, after.
+        let mut left = v * outside;
+        let mut start = 0.0;
+        for &(lo, hi) in &merged[..m] {
+            let gap = (lo - start).max(0.0);
+            if left < gap {
+                return Some((start + left, outside));
+            }
+            left -= gap;
+            start = hi;
+        }
+        Some(((start + left).min(arc), outside))
     }
 
     /// How many of the intervals hold `alpha`.
@@ -355,110 +396,141 @@ impl Space {
     }
 
     // ANCHOR: edge_point
-    /// A point on the edges that can be discontinuities seen from `x` (all
-    /// of them if `all`, else the moving meshes'), but the lamp set's
-    /// ([`Space::lamp_edge_points`]), `inv_pdf` per unit arc length on the
-    /// sphere. Two strategies, the density the mixture's
-    /// whichever drew the point:
+    /// The boundary points of the directional integral at `x` (over all
+    /// edges if `all`, else the moving meshes'), each with `inv_pdf` per
+    /// unit arc length on the sphere, passed to `f`:
     ///
-    /// - the tree's: an edge drawn from the edge hierarchy, a point along
-    ///   its arc, half the time uniform in angle and half on the parts of
-    ///   the arc behind which a lamp lies;
-    /// - by lamp overlap (share [`LAMP_SHARE`], when the tree holds at
-    ///   most [`LAMP_EDGES`] edges and some silhouette's arc has a lamp
-    ///   behind): an edge in proportion to the angle of its arc with a
-    ///   lamp behind over its distance ([`Space::lamp_overlaps`]), a point
-    ///   uniform on those parts.
+    /// - one drawn from the tree of the edges but the lamps' ([`Space::
+    ///   drawn_point`], `u_draw`);
+    /// - when the tree holds at most [`LAMP_EDGES`] edges, one on the lamp
+    ///   parts of each silhouette that has a lamp behind part of its arc
+    ///   (uniform on them, at the fraction `u_set`), the drawn point then
+    ///   avoiding those parts;
+    /// - one on each lamp edge ([`Space::lamp_edge_points`], `u_set`).
     ///
-    /// Any rule for the lamp strategy's weights keeps the estimate
-    /// unbiased, so long as the density reported is that of the draws:
-    /// every term is evaluated from the same `(x, edge)` by the same
-    /// functions on both paths, and the tree's half keeps a floor on every
-    /// point of every discontinuity.
+    /// Every point of every discontinuity is covered by exactly one of
+    /// these, with the density reported: the sum is unbiased.
     #[inline]
-    fn edge_point(&self, x: DVec3, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
+    fn edge_points(
+        &self,
+        x: DVec3,
+        all: bool,
+        u_draw: f64,
+        u_set: f64,
+        mut f: impl FnMut(BoundaryPoint<DVec3>),
+    ) {
         let tables = self.edge_tables();
-        let (edges, facts, weights) = (&tables.edges, &tables.edge_facts, &tables.edge_weight);
+        let (tree, apart, overlap, lamp_total) = self.drawn_tree(x, all);
+        let ids = tree.edges();
+        if let Some(b) = self.drawn_point(x, tree, apart.then_some(&overlap), u_draw) {
+            f(b);
+        }
+        if lamp_total > 0.0 {
+            for (k, &o) in overlap[..ids.len()].iter().enumerate() {
+                if o <= 0.0 {
+                    continue;
+                }
+                let index = ids[k];
+                let edge = &tables.edges[index as usize];
+                let Some(arc) = EdgeArc::new(edge, x) else {
+                    continue;
+                };
+                let Some(lamps) = self.lamp_intervals(x, &arc) else {
+                    continue;
+                };
+                let alpha = lamps.pick(u_set, arc.arc);
+                let cover = lamps.cover(alpha);
+                let q = arc.point(edge, alpha);
+                if cover > 0.0 && q.is_finite() {
+                    f(BoundaryPoint {
+                        q,
+                        shape: edge.shape,
+                        index,
+                        inv_pdf: lamps.total / cover,
+                    });
+                }
+            }
+        }
+        self.lamp_edge_points(x, all, u_set, f);
+    }
+
+    /// The tree the point is drawn from at `x` (all edges but the lamp
+    /// set's if `all`, else the moving ones), whether the lamp parts of
+    /// its silhouettes are taken apart (it holds at most [`LAMP_EDGES`]
+    /// edges and the lamps at most [`LAMP_TRIANGLES`] triangles), and if
+    /// so the edges' [`Space::lamp_overlaps`].
+    #[inline]
+    #[allow(clippy::type_complexity)]
+    fn drawn_tree(&self, x: DVec3, all: bool) -> (&EdgeTree, bool, [f64; LAMP_EDGES], f64) {
+        let tables = self.edge_tables();
         let tree = if all {
             &tables.all_drawn
         } else {
             &tables.moving_drawn
         };
-        let ids = tree.edges();
+        let apart = tree.edges().len() <= LAMP_EDGES
+            && !self.emitters.is_empty()
+            && self.emitters.len() <= LAMP_TRIANGLES;
         // At the sensor's point (a probe's every path starts there) the
-        // lamp weights are computed once per tree.
-        let (overlap, lamp_total) = if x == self.scene.sensor().point() {
+        // lamp parts are found once per tree.
+        let (overlap, total) = if !apart {
+            ([0.0; LAMP_EDGES], 0.0)
+        } else if x == self.scene.sensor().point() {
             *self.sensor_lamps[all as usize].get_or_init(|| self.lamp_overlaps(x, tree))
         } else {
             self.lamp_overlaps(x, tree)
         };
-        let share = if lamp_total > 0.0 { LAMP_SHARE } else { 0.0 };
-        let (index, p_tree, arc, lamps, alpha) = if u < share {
-            // By lamp overlap: the edge, then a point on its lamp parts.
-            let s = (u / share * lamp_total).min(lamp_total * (1.0 - f64::EPSILON));
-            let (mut acc, mut k) = (0.0, usize::MAX);
-            for (i, &o) in overlap[..ids.len()].iter().enumerate() {
-                if o <= 0.0 {
-                    continue;
-                }
-                k = i;
-                if s < acc + o {
-                    break;
-                }
-                acc += o;
-            }
-            // (Past the last part only by rounding: the last part then.)
-            let rest = ((s - acc) / overlap[k]).clamp(0.0, 1.0 - f64::EPSILON);
-            let index = ids[k];
-            let arc = EdgeArc::new(&edges[index as usize], x)?;
-            let lamps = self.lamp_intervals(x, &arc)?;
-            let alpha = lamps.pick(rest, arc.arc);
-            let p_tree = tree.probability(x, index, edges, facts, weights);
-            (index, p_tree, arc, Some(lamps), alpha)
-        } else {
-            // The tree's: half uniform in angle, half on the lamp parts.
-            let u = if share > 0.0 {
-                ((u - share) / (1.0 - share)).min(1.0 - f64::EPSILON)
-            } else {
-                u
-            };
-            let (index, p_tree, along) = tree.sample(x, u, edges, facts, weights)?;
-            let arc = EdgeArc::new(&edges[index as usize], x)?;
-            let lamps = self.lamp_intervals(x, &arc);
-            let alpha = match lamps {
-                Some(ref l) if along >= 0.5 => l.pick(2.0 * along - 1.0, arc.arc),
-                Some(_) => 2.0 * along * arc.arc,
-                None => along * arc.arc,
-            };
-            (index, p_tree, arc, lamps, alpha)
-        };
-        // The mixture's density per unit angle at alpha on this edge.
-        let (by_tree, by_lamp) = match lamps {
-            None => (p_tree / arc.arc, 0.0),
-            Some(ref l) => {
-                let cover = l.cover(alpha);
-                // The edge's share of the draws by lamp overlap (0 if the
-                // cheap test left it out, or the tree is too large for
-                // them), then its point's density.
-                let o = if share > 0.0 {
-                    tree.place(index)
-                        .and_then(|k| overlap.get(k).copied())
-                        .unwrap_or(0.0)
-                } else {
-                    0.0
-                };
-                (
-                    p_tree * (0.5 / arc.arc + 0.5 * cover / l.total),
-                    if o > 0.0 {
-                        o / lamp_total * cover / l.total
-                    } else {
-                        0.0
-                    },
-                )
-            }
-        };
-        let density = (1.0 - share) * by_tree + share * by_lamp;
+        (tree, apart, overlap, total)
+    }
+
+    /// A point drawn on the edges of `tree` that can be discontinuities
+    /// seen from `x`: an edge from the hierarchy, then a point along its
+    /// arc. With `overlap` (per edge of the tree, > 0 where its lamp parts
+    /// are taken apart), uniform in angle on the arc but those parts;
+    /// without, half the time uniform in angle and half on the lamp parts.
+    /// `inv_pdf` per unit arc length.
+    #[inline]
+    fn drawn_point(
+        &self,
+        x: DVec3,
+        tree: &EdgeTree,
+        overlap: Option<&[f64; LAMP_EDGES]>,
+        u: f64,
+    ) -> Option<BoundaryPoint<DVec3>> {
+        let tables = self.edge_tables();
+        let (edges, facts, weights) = (&tables.edges, &tables.edge_facts, &tables.edge_weight);
+        let (index, p_tree, along) = tree.sample(x, u, edges, facts, weights)?;
         let edge = &edges[index as usize];
+        let arc = EdgeArc::new(edge, x)?;
+        let (alpha, density) = match overlap {
+            Some(o) => {
+                let apart = tree.place(index).is_some_and(|k| o[k] > 0.0);
+                match (apart, self.lamp_intervals(x, &arc)) {
+                    (true, Some(l)) => {
+                        let (alpha, outside) = l.pick_outside(along, arc.arc)?;
+                        (alpha, p_tree / outside)
+                    }
+                    _ => (along * arc.arc, p_tree / arc.arc),
+                }
+            }
+            None => match self.lamp_intervals(x, &arc) {
+                Some(l) if along >= 0.5 => {
+                    let alpha = l.pick(2.0 * along - 1.0, arc.arc);
+                    (
+                        alpha,
+                        p_tree * (0.5 / arc.arc + 0.5 * l.cover(alpha) / l.total),
+                    )
+                }
+                Some(l) => {
+                    let alpha = 2.0 * along * arc.arc;
+                    (
+                        alpha,
+                        p_tree * (0.5 / arc.arc + 0.5 * l.cover(alpha) / l.total),
+                    )
+                }
+                None => (along * arc.arc, p_tree / arc.arc),
+            },
+        };
         let q = arc.point(edge, alpha);
         if !q.is_finite() || density.is_nan() || density <= 0.0 {
             return None;
@@ -510,9 +582,11 @@ impl Space {
 
 impl Boundaries for Space {
     // ANCHOR: sample_boundary
-    /// A point on the edges seen from the vertex (`Space::edge_point`),
-    /// or, at a camera pixel, on the moving edges seen through it;
-    /// `inv_pdf` is per unit arc length on the sphere of directions.
+    /// At a camera pixel, a point on the moving edges seen through it;
+    /// elsewhere the point drawn among the edges seen from the vertex,
+    /// without the ones [`Boundaries::boundary_points`] takes every time
+    /// ([`Space::edge_points`]); `inv_pdf` is per unit arc length on the
+    /// sphere of directions.
     #[inline]
     fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
         if let SpaceLobe::Pixel { rect, pixel, .. } = v.lobe {
@@ -521,27 +595,30 @@ impl Boundaries for Space {
             debug_assert!(!all, "a camera does not move");
             return self.pixel_boundary(v.x, pixel, &rect, u);
         }
-        self.edge_point(v.x, all, u)
+        let (tree, apart, overlap, _) = self.drawn_tree(v.x, all);
+        self.drawn_point(v.x, tree, apart.then_some(&overlap), u)
     }
     // ANCHOR_END: sample_boundary
 
-    /// The lamps' edges ([`Space::lamp_edge_points`]), but at a camera
-    /// pixel (whose draws take every moving edge it sees).
+    /// At a camera pixel, the point drawn ([`Space::pixel_boundary`]);
+    /// elsewhere all of [`Space::edge_points`].
     #[inline]
-    fn boundary_set(
+    fn boundary_points(
         &self,
         v: &Vertex<Self>,
         all: bool,
         rng: &mut PathRng,
         mut f: impl FnMut(&mut PathRng, BoundaryPoint<DVec3>),
     ) {
-        if matches!(v.lobe, SpaceLobe::Pixel { .. })
-            || self.edge_tables().lamp_set[all as usize].is_empty()
-        {
+        if let SpaceLobe::Pixel { rect, pixel, .. } = v.lobe {
+            debug_assert!(!all, "a camera does not move");
+            if let Some(b) = self.pixel_boundary(v.x, pixel, &rect, rng.random()) {
+                f(rng, b);
+            }
             return;
         }
-        let u: f64 = rng.random();
-        self.lamp_edge_points(v.x, all, u, |b| f(rng, b));
+        let (u_draw, u_set): (f64, f64) = (rng.random(), rng.random());
+        self.edge_points(v.x, all, u_draw, u_set, |b| f(rng, b));
     }
 
     // ANCHOR: sides

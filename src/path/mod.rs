@@ -323,7 +323,8 @@ pub enum Side {
 /// Where the integrand over directions jumps, and the warp that follows
 /// those jumps: the discontinuity machinery of a geometry.
 pub trait Boundaries: Geometry {
-    /// Draws one boundary point for the directional integral at `v`:
+    /// Draws one boundary point for the directional integral at `v` (see
+    /// [`Boundaries::boundary_points`] for all of them):
     /// among all of them when the vertex or its frame moves (`all`), else
     /// among those of moving shapes; at a camera, among those inside the
     /// stratum's footprint (where `v`'s lobe is not 0).
@@ -335,23 +336,27 @@ pub trait Boundaries: Geometry {
     ) -> Option<BoundaryPoint<Self::V>>
     where
         Self: Sized;
-    /// Calls `f` with the boundary points the directional integral at `v`
-    /// takes every time besides the one drawn: one point on each of a few
-    /// boundaries that [`Boundaries::sample_boundary`] never draws (3D: the
-    /// lamps' edges), placed along them with numbers from `rng` (drawn only
-    /// if there are such boundaries), each `inv_pdf` its density's
-    /// inverse; `f` gets `rng` back to evaluate the term. None by default.
+    /// Calls `f` with the boundary points whose terms estimate the
+    /// boundary term of the directional integral at `v` (as
+    /// [`Boundaries::sample_boundary`] chooses among them), their sum
+    /// unbiased, numbers drawn from `rng` (which `f` gets back to evaluate
+    /// each term). By default the one point `sample_boundary` draws; a
+    /// geometry may take some boundaries every time (3D: the lamps'
+    /// edges, and the lamp parts of silhouettes) and draw among the rest.
     #[inline]
-    fn boundary_set(
+    fn boundary_points(
         &self,
         v: &walk::Vertex<Self>,
         all: bool,
         rng: &mut crate::rng::PathRng,
-        f: impl FnMut(&mut crate::rng::PathRng, BoundaryPoint<Self::V>),
+        mut f: impl FnMut(&mut crate::rng::PathRng, BoundaryPoint<Self::V>),
     ) where
         Self: Sized,
     {
-        let _ = (v, all, rng, f);
+        use rand::RngExt;
+        if let Some(b) = self.sample_boundary(v, all, rng.random()) {
+            f(rng, b);
+        }
     }
     /// What rays just to either side of the direction from `x` to the
     /// boundary point see there: first the side

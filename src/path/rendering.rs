@@ -22,7 +22,6 @@ use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
 use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance};
 use super::{Boundaries, BoundaryPoint, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface, Vector};
 use crate::rng::PathRng;
-use rand::RngExt;
 
 /// The rendering method's hooks: one walk's deformation state.
 pub struct Rendering<'a, G: Geometry> {
@@ -163,11 +162,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     if !all && frozen {
         return;
     }
-    // The drawn point, then the set taken every time.
-    if let Some(b) = g.sample_boundary(v, all, rng.random()) {
-        corner_term(g, slots, d, rng, v, frozen, moving_view, &b);
-    }
-    g.boundary_set(v, all, rng, |rng, b| {
+    g.boundary_points(v, all, rng, |rng, b| {
         corner_term(g, slots, d, rng, v, frozen, moving_view, &b)
     });
 }
