@@ -358,6 +358,19 @@ pub trait Boundaries: Geometry {
             f(rng, b);
         }
     }
+    /// How many pairs of nested paths estimate the jump across each
+    /// boundary point at `v` (averaged): 1 by default. Where boundary
+    /// points are few and their terms weigh much (a camera pixel that a
+    /// moving silhouette crosses), more pairs cost little overall and cut
+    /// the jump's share of the variance.
+    #[inline]
+    fn jump_paths(&self, v: &walk::Vertex<Self>) -> u32
+    where
+        Self: Sized,
+    {
+        let _ = v;
+        1
+    }
     /// What rays just to either side of the direction from `x` to the
     /// boundary point see there: first the side
     /// [`Boundaries::boundary_normal`] points to (plane: counter-clockwise),

@@ -236,15 +236,22 @@ fn corner_term<G: Boundaries>(
         }
         _ => None,
     };
-    let jump = if let Some((a, b)) = shared {
-        reflected_jump(g, rng, a, b, wq, medium)
-    } else {
-        // Common random numbers for the two sides.
-        let mut twin = rng.clone();
-        let l_ahead = side(rng, ahead);
-        let l_behind = side(&mut twin, behind);
-        l_behind - l_ahead
-    };
+    // The jump by `n` pairs of nested paths, averaged (one but at a
+    // camera pixel: see `Boundaries::jump_paths`).
+    let n = g.jump_paths(v).max(1);
+    let mut jump = 0.0;
+    for _ in 0..n {
+        jump += if let Some((a, b)) = shared {
+            reflected_jump(g, rng, a, b, wq, medium)
+        } else {
+            // Common random numbers for the two sides.
+            let mut twin = rng.clone();
+            let l_ahead = side(rng, ahead);
+            let l_behind = side(&mut twin, behind);
+            l_behind - l_ahead
+        };
+    }
+    let jump = jump / n as f64;
     // d/dπ ∫ f L dη ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
     let term = v.beta * f * t * jump * b.inv_pdf;
     for j in involved.iter() {
