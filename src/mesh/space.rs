@@ -64,9 +64,9 @@ pub struct Space {
     /// What the sensor's point sees of the edges (built on first use, by
     /// the expectation method).
     sensor_view: OnceLock<SensorView>,
-    /// The boundary draws' lamp weights of the moving edges and of all
-    /// edges seen from the sensor's point, where every path starts (built
-    /// on first use).
+    /// The lamp overlaps (`Space::lamp_overlaps`) of the moving edges and
+    /// of all edges seen from the sensor's point, where every path starts
+    /// (built on first use).
     pub(super) sensor_lamps: [OnceLock<([f64; LAMP_EDGES], f64)>; 2],
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
