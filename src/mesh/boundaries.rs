@@ -9,7 +9,8 @@
 //! are each covered once ([`Space::edge_points`]):
 //!
 //! - the lamps' edges (when the emitting meshes have at most `LAMP_SET`
-//!   (16)): each taken every time, `SET_POINTS` (2) points per edge,
+//!   (16) and the other meshes at most `LAMP_EDGES` (64)): each taken
+//!   every time, `SET_POINTS` (2) points per edge,
 //!   stratified ([`Space::lamp_edge_points`]). A vertex that moves sees the
 //!   lamp's outline move, and the jump there is the lamp's whole radiance:
 //!   the terms of opposite edges are large and nearly cancel (a point
