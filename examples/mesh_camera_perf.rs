@@ -25,7 +25,12 @@
 //!
 //! Measured 2026-11-24 after the lamp-overlap draws (2 shared cores, budget
 //! 20 s): time to 5 % (cube_x, cube_rot) rendering 34 s, 325 s; transport
-//! 119 s, 503 s; expectation 212 s; fd 129 s (cube_x).
+//! 119 s, 503 s; expectation 212 s; fd 129 s (cube_x). Later that day, with
+//! the lamp edges and the silhouettes' lamp parts taken at every vertex and
+//! two points with two pairs of nested paths per camera pixel (the code
+//! before run back to back: rendering 34 s, 324 s; transport 113 s,
+//! 486 s): rendering 3.4 s, 10.9 s; transport 4.3 s, 14.6 s; expectation
+//! 212 s, 1072 s; fd 116 s (cube_x).
 //!
 //! `cargo run --release --no-default-features --example mesh_camera_perf --
 //! [SCENE] [PILOT] [BUDGET] [THREADS] [OUT]`: defaults

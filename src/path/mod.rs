@@ -338,7 +338,8 @@ pub enum Side {
 /// Where the integrand over directions jumps, and the warp that follows
 /// those jumps: the discontinuity machinery of a geometry.
 pub trait Boundaries: Geometry {
-    /// Draws one boundary point for the directional integral at `v`:
+    /// Draws one boundary point for the directional integral at `v` (see
+    /// [`Boundaries::boundary_points`] for all of them):
     /// among all of them when the vertex or its frame moves (`all`), else
     /// among those of moving shapes; at a camera, among those inside the
     /// stratum's footprint (where `v`'s lobe is not 0).
@@ -350,6 +351,41 @@ pub trait Boundaries: Geometry {
     ) -> Option<BoundaryPoint<Self::V>>
     where
         Self: Sized;
+    /// Calls `f` with the boundary points whose terms estimate the
+    /// boundary term of the directional integral at `v` (as
+    /// [`Boundaries::sample_boundary`] chooses among them), their sum
+    /// unbiased, numbers drawn from `rng` (which `f` gets back to evaluate
+    /// each term). By default the one point `sample_boundary` draws; a
+    /// geometry may take some boundaries every time (3D: the lamps'
+    /// edges, and the lamp parts of silhouettes) and draw among the rest.
+    #[inline]
+    fn boundary_points(
+        &self,
+        v: &walk::Vertex<Self>,
+        all: bool,
+        rng: &mut crate::rng::PathRng,
+        mut f: impl FnMut(&mut crate::rng::PathRng, BoundaryPoint<Self::V>),
+    ) where
+        Self: Sized,
+    {
+        use rand::RngExt;
+        if let Some(b) = self.sample_boundary(v, all, rng.random()) {
+            f(rng, b);
+        }
+    }
+    /// How many pairs of nested paths estimate the jump across each
+    /// boundary point at `v` (averaged): 1 by default. Where boundary
+    /// points are few and their terms weigh much (a camera pixel that a
+    /// moving silhouette crosses), more pairs cost little overall and cut
+    /// the jump's share of the variance.
+    #[inline]
+    fn jump_paths(&self, v: &walk::Vertex<Self>) -> u32
+    where
+        Self: Sized,
+    {
+        let _ = v;
+        1
+    }
     /// What rays just to either side of the direction from `x` to the
     /// boundary point see there: first the side
     /// [`Boundaries::boundary_normal`] points to (plane: counter-clockwise),

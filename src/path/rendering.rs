@@ -20,9 +20,8 @@
 //! "Rendering" and "Corner jumps".
 use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
 use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance};
-use super::{Boundaries, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface, Vector};
+use super::{Boundaries, BoundaryPoint, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface, Vector};
 use crate::rng::PathRng;
-use rand::RngExt;
 
 /// The rendering method's hooks: one walk's deformation state.
 pub struct Rendering<'a, G: Geometry> {
@@ -163,9 +162,24 @@ pub(super) fn corner_jump<G: Boundaries>(
     if !all && frozen {
         return;
     }
-    let Some(b) = g.sample_boundary(v, all, rng.random()) else {
-        return;
-    };
+    g.boundary_points(v, all, rng, |rng, b| {
+        corner_term(g, slots, d, rng, v, frozen, moving_view, &b)
+    });
+}
+
+/// The term of one boundary point `b` seen from `v` ([`corner_jump`]).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn corner_term<G: Boundaries>(
+    g: &G,
+    slots: &Slots,
+    d: &mut Deform<G::V>,
+    rng: &mut PathRng,
+    v: &Vertex<G>,
+    frozen: bool,
+    moving_view: SlotSet,
+    b: &BoundaryPoint<G::V>,
+) {
     let r = b.q - v.x;
     let dist = r.length();
     let wq = r * (1.0 / dist);
@@ -176,7 +190,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     let Some((t, medium)) = reach(g, v.x, b.q, v.medium, v.skip) else {
         return;
     };
-    let normal = g.boundary_normal(v.x, &b);
+    let normal = g.boundary_normal(v.x, b);
     let mut any = false;
     let involved = moving_view.union(movers(slots, b.shape, frozen));
     for j in involved.iter() {
@@ -195,9 +209,9 @@ pub(super) fn corner_jump<G: Boundaries>(
     if !any {
         return;
     }
-    let (ahead, behind) = g.sides(v.x, &b);
+    let (ahead, behind) = g.sides(v.x, b);
     let side = |rng: &mut PathRng, side: Side| match side {
-        Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(&b, p), p, wq, medium),
+        Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(b, p), p, wq, medium),
         Side::Past => radiance(g, rng, b.q, wq, medium, NO_PRIM),
     };
     let reflector = |s: Side| match s {
@@ -212,7 +226,7 @@ pub(super) fn corner_jump<G: Boundaries>(
         // costs more than the shared draws save (measured: a 125° concave
         // corner had rendering's variance four times larger).
         (Some(pa), Some(pb)) => {
-            let (ya, yb) = (g.off_boundary(&b, pa), g.off_boundary(&b, pb));
+            let (ya, yb) = (g.off_boundary(b, pa), g.off_boundary(b, pb));
             let facing = |p: Prim, y: G::V| {
                 let n = g.normal(p, y);
                 if wq.dot(n) > 0.0 { -n } else { n }
@@ -222,15 +236,22 @@ pub(super) fn corner_jump<G: Boundaries>(
         }
         _ => None,
     };
-    let jump = if let Some((a, b)) = shared {
-        reflected_jump(g, rng, a, b, wq, medium)
-    } else {
-        // Common random numbers for the two sides.
-        let mut twin = rng.clone();
-        let l_ahead = side(rng, ahead);
-        let l_behind = side(&mut twin, behind);
-        l_behind - l_ahead
-    };
+    // The jump by `n` pairs of nested paths, averaged (one but at a
+    // camera pixel: see `Boundaries::jump_paths`).
+    let n = g.jump_paths(v).max(1);
+    let mut jump = 0.0;
+    for _ in 0..n {
+        jump += if let Some((a, b)) = shared {
+            reflected_jump(g, rng, a, b, wq, medium)
+        } else {
+            // Common random numbers for the two sides.
+            let mut twin = rng.clone();
+            let l_ahead = side(rng, ahead);
+            let l_behind = side(&mut twin, behind);
+            l_behind - l_ahead
+        };
+    }
+    let jump = jump / n as f64;
     // d/dπ ∫ f L dη ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
     let term = v.beta * f * t * jump * b.inv_pdf;
     for j in involved.iter() {

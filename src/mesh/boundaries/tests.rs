@@ -8,11 +8,13 @@ use std::sync::Arc;
 /// whatever the density, if `inv_pdf` is the inverse of the density
 /// the points are drawn with: on the fog-free showcase (a cube, 12
 /// moving edges, under a two-triangle lamp), from floor points in the
-/// cube's penumbra, lit and in its umbra, and from a point on the cube,
-/// with the moving edges (rendering) and with every edge (transport's
-/// gradient walks), a fine grid of `u` and `Σ inv_pdf` per eighth of
-/// each edge's arc against its angle, within 0.4 % (a pdf wrong by 2 %
-/// on the lamp parts fails it).
+/// cube's penumbra (two), lit and in its umbra, and from a point on the
+/// cube, with the moving edges (rendering) and with every edge (a vertex
+/// that moves), a fine grid of `u` and `Σ inv_pdf` per eighth of each
+/// edge's arc against its angle, over all the points
+/// [`Space::edge_points`] gives (the one drawn, the lamp parts of
+/// silhouettes, the lamp's edges), within 0.4 % (a pdf wrong by 2 % on
+/// the lamp parts fails it).
 #[test]
 fn the_boundary_density_is_that_of_the_draws() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mesh/showcase_nofog.toml");
@@ -27,12 +29,13 @@ fn the_boundary_density_is_that_of_the_draws() {
         DVec3::new(-0.3, 0.0, 0.0),
         DVec3::new(1.5, -1.0, 0.0),
         DVec3::new(-0.3, 0.0, 0.85),
+        DVec3::new(-0.9, 0.0, 0.0),
     ] {
         for all in [false, true] {
             let tree = if all {
-                &tables.all_edges
+                &tables.all_drawn
             } else {
-                &tables.moving_edges
+                &tables.moving_drawn
             };
             if space.lamp_overlaps(x, tree).1 > 0.0 {
                 with_lamp += 1;
@@ -41,20 +44,22 @@ fn the_boundary_density_is_that_of_the_draws() {
             let mut arcs = vec![0.0; tables.edges.len()];
             for k in 0..n {
                 let u = (k as f64 + 0.5) / n as f64;
-                let Some(b) = space.edge_point(x, all, u) else {
-                    continue;
-                };
-                assert!(b.inv_pdf.is_finite() && b.inv_pdf > 0.0);
-                let e = b.index as usize;
-                let edge = &tables.edges[e];
-                let (ra, rb, rq) = (edge.a - x, edge.b - x, b.q - x);
-                let arc = ra.cross(rb).length().atan2(ra.dot(rb));
-                let alpha = ra.cross(rq).length().atan2(ra.dot(rq));
-                let bin = ((alpha / arc * bins as f64) as usize).min(bins - 1);
-                sums[e * bins + bin] += b.inv_pdf / n as f64;
-                arcs[e] = arc;
+                // The drawn point and those taken every time, the same
+                // grid for both numbers (the sum's expectation is the sum
+                // of theirs).
+                space.edge_points(x, all, u, u, |b| {
+                    assert!(b.inv_pdf.is_finite() && b.inv_pdf > 0.0);
+                    let e = b.index as usize;
+                    let edge = &tables.edges[e];
+                    let (ra, rb, rq) = (edge.a - x, edge.b - x, b.q - x);
+                    let arc = ra.cross(rb).length().atan2(ra.dot(rb));
+                    let alpha = ra.cross(rq).length().atan2(ra.dot(rq));
+                    let bin = ((alpha / arc * bins as f64) as usize).min(bins - 1);
+                    sums[e * bins + bin] += b.inv_pdf / n as f64;
+                    arcs[e] = arc;
+                });
             }
-            for &e in tree.edges() {
+            for &e in tree.edges().iter().chain(&tables.lamp_set[all as usize]) {
                 let e = e as usize;
                 // Every edge here is a discontinuity from everywhere
                 // (open, or a reflector's crease): each must be drawn.
@@ -74,4 +79,69 @@ fn the_boundary_density_is_that_of_the_draws() {
         with_lamp >= 4,
         "{with_lamp} views with a lamp behind some edge"
     );
+}
+
+/// The lamps' edges are taken every time ([`Space::lamp_edge_points`]),
+/// never drawn (not in the drawn trees): between them every edge that can
+/// be a discontinuity is covered once. On the fog-free showcase, from
+/// floor and cube points: the lamp set holds the lamp's four edges and
+/// the drawn tree the cube's and the floor's; each lamp edge that is a
+/// discontinuity from `x` gets one point at the fraction `u` of its arc
+/// with `inv_pdf` its arc (so `E[inv_pdf · 1{q in a piece}]` over `u` is
+/// the piece's angle, per eighth of the arc to 1e-9).
+#[test]
+fn the_lamp_edges_are_taken_once_and_never_drawn() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mesh/showcase_nofog.toml");
+    let space = Space::new(Arc::new(file::load(&path).unwrap()));
+    let tables = space.edge_tables();
+    let lamp = |e: u32| tables.edges[e as usize].shape == 0;
+    assert_eq!(tables.lamp_set[1], vec![0, 1, 2, 3]);
+    assert!(tables.lamp_set[0].is_empty(), "the lamp stands still");
+    let mut covered: Vec<u32> = tables.all_drawn.edges().to_vec();
+    covered.extend(&tables.lamp_set[1]);
+    covered.sort();
+    assert_eq!(covered, (0..tables.edges.len() as u32).collect::<Vec<_>>());
+    assert!(tables.all_drawn.edges().iter().all(|&e| !lamp(e)));
+    let bins = 8;
+    let n = 10_000;
+    for x in [
+        DVec3::new(-0.3, 0.55, 0.0),
+        DVec3::new(1.5, -1.0, 0.0),
+        DVec3::new(-0.3, 0.0, 0.85),
+    ] {
+        let mut sums = vec![0.0; 4 * bins];
+        for k in 0..n {
+            let u = (k as f64 + 0.5) / n as f64;
+            let mut seen = Vec::new();
+            space.lamp_edge_points(x, true, u, |b| {
+                seen.push(b.index);
+                let edge = &tables.edges[b.index as usize];
+                let (ra, rb, rq) = (edge.a - x, edge.b - x, b.q - x);
+                let arc = ra.cross(rb).length().atan2(ra.dot(rb));
+                assert!((b.inv_pdf - arc).abs() < 1e-12 * arc);
+                let alpha = ra.cross(rq).length().atan2(ra.dot(rq));
+                assert!(
+                    (alpha - u * arc).abs() < 1e-9,
+                    "x {x}: {alpha} against {}",
+                    u * arc
+                );
+                let bin = ((alpha / arc * bins as f64) as usize).min(bins - 1);
+                sums[b.index as usize * bins + bin] += b.inv_pdf / n as f64;
+            });
+            assert_eq!(seen, vec![0, 1, 2, 3], "x {x}: every lamp edge once");
+            space.lamp_edge_points(x, false, u, |b| panic!("the lamp stands still: {b:?}"));
+        }
+        for e in 0..4 {
+            let edge = &tables.edges[e];
+            let (ra, rb) = (edge.a - x, edge.b - x);
+            let arc = ra.cross(rb).length().atan2(ra.dot(rb));
+            for bin in 0..bins {
+                let got = sums[e * bins + bin];
+                assert!(
+                    (got - arc / bins as f64).abs() < 1e-9,
+                    "x {x}, edge {e}, bin {bin}: {got}"
+                );
+            }
+        }
+    }
 }
