@@ -6,12 +6,12 @@
 //!
 //! The boundary term of the directional integral is a line integral along
 //! those arcs, `∮ f (L_behind − L_ahead) v_n dl`, split into parts that
-//! are each covered once ([`Space::edge_points`]):
+//! are each covered once (`Space::edge_points`):
 //!
 //! - the lamps' edges (when the emitting meshes have at most `LAMP_SET`
 //!   (16) and the other meshes at most `LAMP_EDGES` (64)): each taken
 //!   every time, `SET_POINTS` (2) points per edge,
-//!   stratified ([`Space::lamp_edge_points`]). A vertex that moves sees the
+//!   stratified (`Space::lamp_edge_points`). A vertex that moves sees the
 //!   lamp's outline move, and the jump there is the lamp's whole radiance:
 //!   the terms of opposite edges are large and nearly cancel (a point
 //!   turning with a rotating cube sees the whole outline turn), so drawing
@@ -616,7 +616,7 @@ impl Boundaries for Space {
     /// At a camera pixel, a point on the moving edges seen through it;
     /// elsewhere the point drawn among the edges seen from the vertex,
     /// without the ones [`Boundaries::boundary_points`] takes every time
-    /// ([`Space::edge_points`]); `inv_pdf` is per unit arc length on the
+    /// (`Space::edge_points`); `inv_pdf` is per unit arc length on the
     /// sphere of directions.
     #[inline]
     fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
@@ -631,8 +631,8 @@ impl Boundaries for Space {
     }
     // ANCHOR_END: sample_boundary
 
-    /// At a camera pixel, [`CAMERA_POINTS`] points drawn, stratified
-    /// ([`Space::pixel_boundary`]); elsewhere all of [`Space::edge_points`].
+    /// At a camera pixel, `CAMERA_POINTS` points drawn, stratified
+    /// (`Space::pixel_boundary`); elsewhere all of `Space::edge_points`.
     #[inline]
     fn boundary_points(
         &self,
@@ -662,7 +662,7 @@ impl Boundaries for Space {
         self.edge_points(v.x, all, u_draw, u_set, |b| f(rng, b));
     }
 
-    /// [`CAMERA_JUMP_PATHS`] at a camera pixel, else 1.
+    /// `CAMERA_JUMP_PATHS` at a camera pixel, else 1.
     #[inline]
     fn jump_paths(&self, v: &Vertex<Self>) -> u32 {
         if matches!(v.lobe, SpaceLobe::Pixel { .. }) {
