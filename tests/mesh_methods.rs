@@ -42,7 +42,7 @@ fn against_fd(
     let (a, b) = (r.get(&q).unwrap(), fd.get(&q).unwrap());
     let z = (a.mean - b.mean) / a.stderr.hypot(b.stderr);
     eprintln!(
-        "{m} {name}: {:.5} ± {:.5} vs fd {:.5} ± {:.5} (z {z:.2})",
+        "{m} {name}: {:.6} ± {:.2e} vs fd {:.6} ± {:.2e} (z {z:.2})",
         a.mean, a.stderr, b.mean, b.stderr
     );
     assert!(z.abs() < 4.0, "{m} {name}: {a:?} vs fd {b:?}");
@@ -198,7 +198,7 @@ fn occluders_match_the_closed_forms() {
             for (name, exact) in names.iter().zip(s) {
                 let a = r.get(&Quantity::sensitivity(name)).unwrap();
                 eprintln!(
-                    "{m} {name}: {:.5} ± {:.5} vs exact {exact:.5} (z {:.2})",
+                    "{m} {name}: {:.6} ± {:.2e} vs exact {exact:.6} (z {:.2})",
                     a.mean,
                     a.stderr,
                     (a.mean - exact) / a.stderr
@@ -262,8 +262,10 @@ fn floor_radiance_and_sensor_gradient_match_the_closed_forms() {
             let exact = k * sensitivity(&g, &o.occluder(), motion);
             let a = r.get(&Quantity::sensitivity(name)).unwrap();
             eprintln!(
-                "{m} {name}: {:.5} ± {:.5} vs exact {exact:.5}",
-                a.mean, a.stderr
+                "{m} {name}: {:.6} ± {:.2e} vs exact {exact:.6} (z {:.2})",
+                a.mean,
+                a.stderr,
+                (a.mean - exact) / a.stderr
             );
             assert!(a.z_score(exact) < 4.0, "{m} {name}: {a:?} vs {exact}");
         }
@@ -279,8 +281,10 @@ fn floor_radiance_and_sensor_gradient_match_the_closed_forms() {
         let exact = (at(d * h) - at(-d * h)) / (2.0 * h);
         let a = r.get(&Quantity::gradient(axis)).unwrap();
         eprintln!(
-            "transport dI/d{axis}: {:.5} ± {:.5} vs exact {exact:.5}",
-            a.mean, a.stderr
+            "transport dI/d{axis}: {:.6} ± {:.2e} vs exact {exact:.6} (z {:.2})",
+            a.mean,
+            a.stderr,
+            (a.mean - exact) / a.stderr
         );
         assert!(a.z_score(exact) < 4.0, "∂I/∂{axis}: {a:?} vs {exact}");
         assert!(a.stderr < 0.05 * exact.abs().max(0.05), "∂I/∂{axis}: {a:?}");
@@ -461,7 +465,12 @@ fn a_long_prism_is_flatland_times_pi_over_two() {
         for (j, (name, _)) in motions.iter().enumerate() {
             let exact = k * reference.derivative(j);
             let a = r.get(&Quantity::sensitivity(name)).unwrap();
-            eprintln!("{m} {name}: {:.5} ± {:.5} vs {exact:.5}", a.mean, a.stderr);
+            eprintln!(
+                "{m} {name}: {:.6} ± {:.2e} vs {exact:.6} (z {:.2})",
+                a.mean,
+                a.stderr,
+                (a.mean - exact) / a.stderr
+            );
             assert!(a.z_score(exact) < 4.0, "{m} {name}: {a:?} vs {exact}");
             assert!(a.stderr < 0.05 * exact.abs().max(0.02), "{m} {name}: {a:?}");
         }
