@@ -147,13 +147,6 @@ impl SensorGaps {
         gaps
     }
 
-    /// The cosine lobe's density at `w` (about `n`), the mixture's first
-    /// part before its weight `1 − B`.
-    #[inline]
-    fn lobe_pdf(&self, w: DVec2) -> f64 {
-        0.5 * w.dot(self.n).max(0.0)
-    }
-
     // ANCHOR: mixture
     /// A direction drawn with the mixture's density (the lobe is drawn as
     /// the lobe draws itself, after one uniform number picks the part).
@@ -175,10 +168,11 @@ impl SensorGaps {
         DVec2::from_angle(psi).rotate(self.n)
     }
 
-    /// The mixture's density at `w`.
+    /// The mixture's density at `w`, `lobe` the sensor's cosine lobe.
     #[inline]
-    pub fn pdf(&self, w: DVec2) -> f64 {
-        let lobe = (1.0 - self.share) * self.lobe_pdf(w);
+    pub fn pdf(&self, lobe: &super::lobe::FlatLobe, w: DVec2) -> f64 {
+        use crate::path::Lobe;
+        let lobe = (1.0 - self.share) * lobe.pdf(w);
         let psi = cross(self.n, w).atan2(self.n.dot(w));
         let i = self.start.partition_point(|&s| s <= psi);
         if i == 0 {
@@ -207,6 +201,11 @@ mod tests {
         SensorGaps::new(&Plane::new(Arc::new(scene)))
     }
 
+    /// The sensor's cosine lobe.
+    fn cosine(g: &SensorGaps) -> crate::flat::lobe::FlatLobe {
+        crate::flat::lobe::FlatLobe::Cosine { n: g.n, c: 1.0 }
+    }
+
     /// ∫ q over the circle by the midpoint rule, each gap with its own
     /// fine grid.
     fn integral(g: &SensorGaps, from: f64, to: f64, steps: usize) -> f64 {
@@ -214,7 +213,7 @@ mod tests {
         (0..steps)
             .map(|i| {
                 let psi = from + (i as f64 + 0.5) * h;
-                g.pdf(DVec2::from_angle(psi).rotate(g.n)) * h
+                g.pdf(&cosine(g), DVec2::from_angle(psi).rotate(g.n)) * h
             })
             .sum()
     }
@@ -232,7 +231,7 @@ mod tests {
             + integral(&g, a + w, FRAC_PI_2, 200_000);
         assert!((total - 1.0).abs() < 1e-6, "∫ q = {total}");
         // Draws: the share of each bin (the gap one of them) against ∫ q.
-        let lobe = crate::flat::lobe::FlatLobe::Cosine { n: g.n, c: 1.0 };
+        let lobe = cosine(&g);
         let mut rng = crate::rng::PathRng::seed_from_u64(4);
         let n = 1_000_000;
         let mut edges: Vec<f64> = (0..=16).map(|i| -FRAC_PI_2 + PI_16 * i as f64).collect();

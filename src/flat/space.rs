@@ -352,8 +352,8 @@ impl Geometry for Plane {
         self.sensor_gaps().sample(lobe, rng)
     }
     #[inline]
-    fn sensor_mixture_pdf(&self, _lobe: &FlatLobe, w: DVec2) -> f64 {
-        self.sensor_gaps().pdf(w)
+    fn sensor_mixture_pdf(&self, lobe: &FlatLobe, w: DVec2) -> f64 {
+        self.sensor_gaps().pdf(lobe, w)
     }
     #[inline]
     fn spin(&self, j: usize) -> f64 {
