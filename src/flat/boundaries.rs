@@ -9,6 +9,7 @@ use super::geometry::{NO_SEGMENT, cross, perp};
 use super::lobe::FlatLobe;
 use super::scene::{Phase, Sensor as FlatSensor};
 use super::space::{Knot, Plane};
+use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
 use crate::path::{Boundaries, BoundaryPoint, Hit, NO_PRIM, Side};
 use glam::DVec2;
@@ -116,7 +117,13 @@ impl Boundaries for Plane {
 
     type Warp = FlatWarp;
 
-    fn warp(&self, v: &Vertex<Self>, w: DVec2, ahead: Option<Option<Hit>>) -> FlatWarp {
+    fn warp(
+        &self,
+        v: &Vertex<Self>,
+        w: DVec2,
+        ahead: Option<Option<Hit>>,
+        _frame: SlotSet,
+    ) -> FlatWarp {
         let horizons = v.lobe.horizons(w);
         let (ccw, cw) = if v.at_sensor {
             self.sensor_knots(w, horizons)
@@ -488,7 +495,7 @@ pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
         at_sensor,
         mixed: false,
     };
-    let field = plane.warp(&v, w, None);
+    let field = plane.warp(&v, w, None, SlotSet::EMPTY);
     (0..n)
         .map(|j| {
             let velocity = |q: DVec2, k: u32| {

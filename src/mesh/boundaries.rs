@@ -39,6 +39,7 @@ use super::lobe::SpaceLobe;
 use super::space::Edge;
 use super::space::Space;
 use super::warp::SpaceWarp;
+use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
 use crate::path::{Boundaries, BoundaryPoint, Hit, NO_PRIM, Prim, Side};
 use crate::rng::PathRng;
@@ -719,8 +720,14 @@ impl Boundaries for Space {
     /// The fibre warp of [`super::warp`].
     type Warp = SpaceWarp;
 
-    fn warp(&self, v: &Vertex<Self>, w: DVec3, _ahead: Option<Option<Hit>>) -> SpaceWarp {
-        self.fibre_warp(v, w)
+    fn warp(
+        &self,
+        v: &Vertex<Self>,
+        w: DVec3,
+        _ahead: Option<Option<Hit>>,
+        frame: SlotSet,
+    ) -> SpaceWarp {
+        self.fibre_warp(v, w, frame)
     }
 
     fn warp_shapes(&self, warp: &SpaceWarp, f: impl FnMut(u32)) {

@@ -72,6 +72,24 @@ pub struct Space {
     /// parameter the index of its rule.
     pub(super) pole_rules: Vec<PoleRule>,
     pub(super) slot_field: Vec<u8>,
+    /// Per pole rule, the bounding spheres of the meshes its parameters
+    /// move; last, those of every moving mesh (a camera's one family).
+    pub(super) field_bounds: Vec<Vec<Sphere>>,
+}
+
+/// A bounding sphere: centre and radius.
+pub(super) type Sphere = (DVec3, f64);
+
+/// A sphere around `points` (their box's centre, the farthest from it),
+/// padded against rounding.
+fn bounding_sphere(points: &[DVec3]) -> Sphere {
+    let (lo, hi) = points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &q| (lo.min(q), hi.max(q)),
+    );
+    let c = 0.5 * (lo + hi);
+    let r = points.iter().map(|&q| q.distance(c)).fold(0.0, f64::max);
+    (c, r * (1.0 + 1e-9) + 1e-12 * c.abs().max_element().max(r))
 }
 
 /// The edges of the opaque meshes that can be discontinuities, with what
@@ -168,6 +186,16 @@ impl Space {
             SceneSensor::Camera(c) => Some(c.frame()),
             _ => None,
         };
+        let mut field_bounds = vec![Vec::new(); pole_rules.len() + 1];
+        for (j, &f) in slot_field.iter().enumerate() {
+            let k = scene.parameter_shape(j) as usize;
+            let sphere = bounding_sphere(&scene.shapes()[k].vertices);
+            for f in [f as usize, pole_rules.len()] {
+                if !field_bounds[f].contains(&sphere) {
+                    field_bounds[f].push(sphere);
+                }
+            }
+        }
         Space {
             caster: TriangleBvh::new(tris.clone()),
             opaque: TriangleBvh::new(opaque_tris),
@@ -185,6 +213,7 @@ impl Space {
             sensor_lamps: [OnceLock::new(), OnceLock::new()],
             pole_rules,
             slot_field,
+            field_bounds,
         }
     }
 

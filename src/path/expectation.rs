@@ -47,8 +47,8 @@ fn warp<G: Boundaries>(
     ahead: Option<Option<Hit>>,
 ) {
     let turning = frame_spins(g, slots, d, v, false);
-    let field = g.warp(v, w, ahead);
     let mut involved = d.live.union(turning);
+    let field = g.warp(v, w, ahead, involved);
     g.warp_shapes(&field, |k| involved = involved.union(slots.moving(k)));
     for j in involved.iter() {
         let s = &mut d.slots[j];

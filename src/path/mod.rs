@@ -409,8 +409,17 @@ pub trait Boundaries: Geometry {
     /// The warp at `v` around the direction `w` drawn there. `ahead`, when
     /// the caller has cast the ray already, is its first hit (`Some(None)`:
     /// it escapes); a geometry whose search starts from that hit then need
-    /// not cast it again.
-    fn warp(&self, v: &walk::Vertex<Self>, w: Self::V, ahead: Option<Option<Hit>>) -> Self::Warp
+    /// not cast it again. `frame` holds the slots whose vertex or frame
+    /// may move at `v`; the others have `u = 0` and `Ω = 0`, so their field
+    /// is zero wherever no moving discontinuity is near (a geometry may
+    /// skip its search there).
+    fn warp(
+        &self,
+        v: &walk::Vertex<Self>,
+        w: Self::V,
+        ahead: Option<Option<Hit>>,
+        frame: deform::SlotSet,
+    ) -> Self::Warp
     where
         Self: Sized;
     /// Calls `f` with every shape whose motion the warp at `w` follows.
