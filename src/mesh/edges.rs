@@ -67,8 +67,7 @@ fn edge_importance(e: &Edge, weight: f64, x: DVec3) -> f64 {
 
 /// A leaf's edges' importances seen from `x`, by distance and by weight
 /// (0 for an edge that is no discontinuity from `x`), and their totals: what
-/// [`EdgeTree::sample`] draws a leaf's edge by and
-/// [`EdgeTree::probability`] reads back.
+/// [`EdgeTree::sample`] draws a leaf's edge by.
 #[inline]
 #[allow(clippy::type_complexity)]
 fn leaf_importances(
@@ -363,8 +362,7 @@ impl EdgeTree {
     /// `r` seen from `x`, under each half of the mixture (by distance, by
     /// weight), a culled child counting 0; `None` when both are culled or
     /// the estimates are degenerate (a dead end). What
-    /// [`EdgeTree::sample`] chooses by and [`EdgeTree::probability`] reads
-    /// back.
+    /// [`EdgeTree::sample`] chooses by.
     #[inline]
     fn left_shares(&self, l: usize, r: usize, x: DVec3) -> Option<(f64, f64)> {
         let (open_l, open_r) = (self.open(l, x), self.open(r, x));
@@ -381,59 +379,6 @@ impl EdgeTree {
             return None;
         }
         Some((nl / t_near, wl / t_weight))
-    }
-
-    /// The probability with which [`EdgeTree::sample`] draws edge `e` from
-    /// `x` (0 if it cannot: not in the tree, culled, or not a
-    /// discontinuity from `x`): the one descent toward `e`'s leaf, each
-    /// choice's probability under both halves of the mixture exactly as
-    /// `sample` computes them, so the two agree to the last bit.
-    #[inline]
-    pub fn probability(
-        &self,
-        x: DVec3,
-        e: u32,
-        edges: &[Edge],
-        facts: &[EdgeFacts],
-        weights: &[f64],
-    ) -> f64 {
-        let Some(target) = self.place(e) else {
-            return 0.0;
-        };
-        if self.nodes.is_empty() || !self.open(0, x) {
-            return 0.0;
-        }
-        // Node `i` holds the edges `order[start..end]`; a split puts the
-        // first half (rounded down) on the left, as `build` does.
-        let (mut i, mut start, mut end) = (0, 0, self.order.len());
-        let (mut p_near, mut p_weight) = (1.0, 1.0);
-        loop {
-            let n = self.nodes[i];
-            if n.count > 0 {
-                let ids = &self.order[n.first as usize..(n.first + n.count) as usize];
-                let (by_near, by_weight, t_near, t_weight) =
-                    leaf_importances(ids, edges, facts, weights, x);
-                if !(t_near > 0.0 && t_near.is_finite() && t_weight > 0.0) {
-                    return 0.0;
-                }
-                let k = target - n.first as usize;
-                return 0.5 * (p_near * by_near[k] / t_near + p_weight * by_weight[k] / t_weight);
-            }
-            let (l, r) = (n.first as usize, n.first as usize + 1);
-            let Some((near_l, weight_l)) = self.left_shares(l, r, x) else {
-                return 0.0;
-            };
-            let mid = start + (end - start) / 2;
-            if target < mid {
-                p_near *= near_l;
-                p_weight *= weight_l;
-                (i, end) = (l, mid);
-            } else {
-                p_near *= 1.0 - near_l;
-                p_weight *= 1.0 - weight_l;
-                (i, start) = (r, mid);
-            }
-        }
     }
 
     /// Calls `f` with every discontinuity edge seen from `x` that may cross
