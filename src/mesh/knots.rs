@@ -168,9 +168,7 @@ fn crossing_knot(e: &Edge, cos: f64, q: DVec3) -> FibreKnot {
             q,
             dir: e.b - e.a,
             shape: e.shape,
-            e_theta: DVec3::ZERO,
-            inv_r: 0.0,
-            inv_across: 0.0,
+            rate: DVec3::ZERO,
         }),
     }
 }

@@ -58,11 +58,13 @@ pub struct Crossing {
     pub dir: DVec3,
     /// The mesh.
     pub shape: u32,
-    /// `e_θ` at the crossing's direction, `1/r`, `1/(dir·m)` (filled for
-    /// the chosen knots only).
-    pub(super) e_theta: DVec3,
-    pub(super) inv_r: f64,
-    pub(super) inv_across: f64,
+    /// What turns a relative velocity `v` of the crossing's edge into the
+    /// knot's rate `α = v·rate` (filled for the chosen knots only): the
+    /// crossing stays in the fibre's fixed plane, so it slides along the
+    /// edge by what takes it off the plane, `v − dir (v·m)/(dir·m)`, and
+    /// that slide's component along `e_θ`, over `r`, is `α`. Linear in `v`:
+    /// `rate = (e_θ − m (dir·e_θ)/(dir·m)) / r`.
+    pub(super) rate: DVec3,
 }
 
 /// Most fibre families one warp builds (distinct poles): the motions use at
@@ -299,13 +301,17 @@ impl Space {
             let d = e.q - x;
             let inv_r = 1.0 / d.length();
             let wq = d * inv_r;
+            let e_theta = u * wq.dot(p) - p * wq.dot(u);
             let across = e.dir.dot(m);
+            let off = if across == 0.0 {
+                DVec3::ZERO
+            } else {
+                m * (e.dir.dot(e_theta) / across)
+            };
             FibreKnot {
                 cos: k.cos,
                 edge: Some(Crossing {
-                    e_theta: u * wq.dot(p) - p * wq.dot(u),
-                    inv_r,
-                    inv_across: if across == 0.0 { 0.0 } else { 1.0 / across },
+                    rate: (e_theta - off) * inv_r,
                     ..e
                 }),
             }
@@ -346,11 +352,7 @@ impl Space {
             let Some(e) = k.edge else {
                 return 0.0;
             };
-            let v_rel = velocity(e.q, e.shape) - u - spin.cross(e.q - x);
-            // The crossing stays in the fixed plane: it slides along the
-            // edge by what takes it off the plane.
-            let slide = v_rel - e.dir * (v_rel.dot(warp.m) * e.inv_across);
-            slide.dot(e.e_theta) * e.inv_r
+            (velocity(e.q, e.shape) - u - spin.cross(e.q - x)).dot(e.rate)
         };
         let (a_lo, a_hi) = (rate(&warp.lo), rate(&warp.hi));
         // α is linear in t = −cos θ between the knots: ∂α/∂θ = slope · sin θ.
