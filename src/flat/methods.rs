@@ -106,7 +106,8 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
         names.push(Quantity::gradient("y"));
     }
     let geometry = Plane::new(scene);
-    let slots = Slots::new(&geometry, geometry.scene().shapes().len(), gradient);
+    let twins = scheme == Scheme::Transport;
+    let slots = Slots::new(&geometry, geometry.scene().shapes().len(), gradient, twins);
     DerivativeEstimator {
         geometry,
         slots,

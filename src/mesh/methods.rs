@@ -86,7 +86,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Spac
     let shapes = scene.shapes().len();
     let caveats = kinks(&scene);
     let geometry = Space::new(scene);
-    let slots = Slots::new(&geometry, shapes, gradient);
+    let slots = Slots::new(&geometry, shapes, gradient, scheme == Scheme::Transport);
     DerivativeEstimator {
         geometry,
         slots,

@@ -16,9 +16,9 @@ use super::{Boundaries, Geometry, Hit, Vector};
 use crate::estimator::within_rounding;
 use crate::rng::PathRng;
 
-/// Most derivative slots a walk carries (shape parameters plus the sensor's
-/// gradient axes).
-pub const MAX_SLOTS: usize = 256;
+/// Most derivative slots a walk carries (shape parameters, the sensor's
+/// gradient axes, and transport's twins of the parameters).
+pub const MAX_SLOTS: usize = 512;
 
 /// A set of derivative slots, as bits.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -339,12 +339,19 @@ pub struct Slots {
     pub parameter_slots: SlotSet,
     /// The gradient slots.
     pub gradient_slots: SlotSet,
+    /// Number of twin slots after the gradient axes: 0, or one per
+    /// parameter (transport's frozen-scene continuations, see
+    /// [`Slots::twin`]).
+    pub twins: usize,
+    /// The twin slots.
+    pub twin_slots: SlotSet,
 }
 
 impl Slots {
     /// The slots of `g`'s parameters (at most [`MAX_SLOTS`] in all, with
-    /// the gradient axes when `gradient`), over `shapes` shapes.
-    pub fn new<G: Geometry>(g: &G, shapes: usize, gradient: bool) -> Slots {
+    /// the gradient axes when `gradient`, and a twin per parameter when
+    /// `twins`), over `shapes` shapes.
+    pub fn new<G: Geometry>(g: &G, shapes: usize, gradient: bool, twins: bool) -> Slots {
         let params = g.parameters();
         let axes = if gradient { G::V::DIM } else { 0 };
         let mut shape_slots = vec![SlotSet::EMPTY; shapes];
@@ -357,19 +364,35 @@ impl Slots {
         for j in all.iter().filter(|&j| j >= params) {
             gradient_slots.insert(j);
         }
+        let twins = if twins { params } else { 0 };
+        let mut twin_slots = SlotSet::EMPTY;
+        for j in params + axes..params + axes + twins {
+            twin_slots.insert(j);
+        }
         Slots {
             params,
             axes,
             shape_slots,
             parameter_slots,
             gradient_slots,
+            twins,
+            twin_slots,
         }
     }
 
     /// Number of slots.
     #[inline]
     pub fn len(&self) -> usize {
-        self.params + self.axes
+        self.params + self.axes + self.twins
+    }
+
+    /// The twin of parameter slot `j`: a slot that no shape moves, whose
+    /// state is a frozen-scene continuation of the path (transport's
+    /// nested frozen walks, carried by the path itself: they are linear in
+    /// their start states). Its derivative adds to slot `j`'s.
+    #[inline]
+    pub fn twin(&self, j: usize) -> usize {
+        self.params + self.axes + j
     }
 
     /// Whether there is no slot.
@@ -381,7 +404,16 @@ impl Slots {
     /// Every slot.
     #[inline]
     pub fn all(&self) -> SlotSet {
-        self.parameter_slots.union(self.gradient_slots)
+        self.parameter_slots
+            .union(self.gradient_slots)
+            .union(self.twin_slots)
+    }
+
+    /// The slots that follow the path with the scene frozen (rendering's
+    /// rules): the gradient axes and the twins.
+    #[inline]
+    pub fn frozen_scene(&self) -> SlotSet {
+        self.gradient_slots.union(self.twin_slots)
     }
 
     /// The slots that move shape `k`.

@@ -158,7 +158,7 @@ impl<G: Boundaries> DerivativeEstimator<G> {
             }
             Scheme::Transport => {
                 let mut h = Transport::new(slots, scratch, d);
-                (reading(g, &mut h, rng, pixel), h.d)
+                (reading(g, &mut h, rng, pixel), h.finish())
             }
         };
         out[0] = i;

@@ -86,6 +86,71 @@ impl<G: Boundaries> Transport<'_, G> {
     }
     // ANCHOR_END: surface_gradient
 
+    // ANCHOR: twin_gradient
+    /// [`Self::surface_gradient`] at a moving reflector, carried by the
+    /// twins: the nested walk would start a hair before `v.x` with the
+    /// velocities `v_j(y)` and be subtracted; by linearity the twins take
+    /// `−v_j` there and follow the path on. What that walk's first, tiny
+    /// leg does is done here: the hit's `ṫ_b` for the start velocity, the
+    /// transmittance's and the in-scattering's terms of a medium, and the
+    /// arrival on the surface (`u += η ṫ_b`).
+    fn twin_gradient(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, v: &Vertex<G>, k: u32) {
+        let Leg {
+            w, medium, beta, ..
+        } = *leg;
+        let n = g.normal(v.skip, v.x);
+        let wn = w.dot(n);
+        if wn == 0.0 {
+            return;
+        }
+        let coefficients = g.coefficients(medium);
+        // The in-scattered radiance just before the point, shared by the
+        // slots (the nested walk's Leibniz term over its first leg).
+        let scattered = match coefficients {
+            Some((ks, _)) if ks > 0.0 => {
+                let end = v.x - w * (0.5e-9 * g.size());
+                let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
+                beta * ks * radiance(g, rng, end, wi, medium, NO_PRIM)
+            }
+            _ => 0.0,
+        };
+        let ke = coefficients.map_or(0.0, |c| c.1);
+        for j in self.slots.moving(k).iter() {
+            let vj = g.velocity(j, v.x);
+            let along = vj.dot(n);
+            // As `Deform::boundary_speed` rounds a speed along the surface.
+            let tb = if crate::estimator::within_rounding(along, vj.length()) {
+                0.0
+            } else {
+                along / wn
+            };
+            let t = self.slots.twin(j);
+            let s = &mut self.d.slots[t];
+            if scattered != 0.0 {
+                s.add_boundary(scattered * tb, (scattered * tb).abs());
+            }
+            if ke != 0.0 {
+                s.add_score(-ke * tb);
+            }
+            s.u = s.u - vj + w * tb;
+            self.d.touch(t);
+        }
+    }
+    // ANCHOR_END: twin_gradient
+
+    /// The path's state with each twin's derivative added to its
+    /// parameter's.
+    pub fn finish(mut self) -> Deform<G::V> {
+        for j in self.slots.parameter_slots.iter() {
+            let t = self.slots.twin(j);
+            if t < self.d.len() && self.slots.twins > 0 {
+                let (b, scale) = (self.d.slots[t].boundary, self.d.slots[t].boundary_scale);
+                self.d.slots[j].add_boundary(b, scale);
+            }
+        }
+        self.d
+    }
+
     /// A walk in the frozen scene from `x` along `w` that differentiates
     /// the start velocities held in `nested`; returns its state. `drawn`:
     /// how the main path drew `w`, so that a lamp it hits first carries the
@@ -120,7 +185,7 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     }
     #[inline]
     fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
-        leibniz(g, &mut self.d, self.slots.gradient_slots, rng, leg, t_b);
+        leibniz(g, &mut self.d, self.slots.frozen_scene(), rng, leg, t_b);
     }
     #[inline]
     fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
@@ -128,11 +193,11 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     }
     #[inline]
     fn pass(&mut self, ke: f64) {
-        self.d.pass(self.slots.gradient_slots, ke);
+        self.d.pass(self.slots.frozen_scene(), ke);
     }
     #[inline]
     fn arrive(&mut self, w: G::V, t: f64) {
-        self.d.arrive(self.slots.gradient_slots, w, t);
+        self.d.arrive(self.slots.frozen_scene(), w, t);
     }
     #[inline]
     fn emission(&mut self, contribution: f64) {
@@ -189,7 +254,11 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             return;
         }
         // The incoming radiance's gradient at the moving point first.
-        self.surface_gradient(g, rng, leg, v.x, k, None);
+        if self.slots.twins > 0 {
+            self.twin_gradient(g, rng, leg, v, k);
+        } else {
+            self.surface_gradient(g, rng, leg, v.x, k, None);
+        }
         // The material derivative of the reflected radiance: the point moves
         // with the surface (the corner terms see it move).
         for j in moving.iter() {
@@ -208,6 +277,21 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     #[inline]
     fn reflected(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>, w: G::V) {
         let params = self.slots.parameter_slots;
+        if self.moving_reflector && self.slots.twins > 0 {
+            // … and its regular part: the path goes on fixed in space, and
+            // the twins carry the moving point's velocities along it in
+            // the frozen scene.
+            for j in params.iter() {
+                let t = self.slots.twin(j);
+                let (u, wd) = (self.d.slots[j].u, self.d.slots[j].wd);
+                let s = &mut self.d.slots[t];
+                s.u = s.u + u;
+                s.wd = s.wd + wd;
+                self.d.slots[j].u = G::V::ZERO;
+                self.d.touch(t);
+            }
+            self.moving_reflector = false;
+        }
         if self.moving_reflector {
             // … and its regular part: the radiance reflected at the moving
             // point in the turning frame, by a nested walk in the frozen
