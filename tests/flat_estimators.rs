@@ -406,3 +406,42 @@ fn finite_differences_take_any_number_of_parameters_and_name_a_bad_displacement(
         }
     }
 }
+
+/// Transport carries the nested frozen walks of a moving reflector on the
+/// path itself, in a twin slot per parameter, where twins fit in a walk's
+/// slots (up to 126 parameters); past that it walks them. The two must
+/// agree: the submerged wedge (a moving reflector in fog) with 130 copies
+/// of its translation, every original parameter against the same scene's
+/// twin-carried estimate, and every copy equal to the first.
+#[test]
+fn transport_with_and_without_twins_agrees() {
+    use geosens::flat::Parameter;
+    let base = scene("submerged.toml");
+    let mut parameters = base.parameters().to_vec();
+    let wedge = parameters
+        .iter()
+        .find(|p| p.name == "wedge_tx")
+        .unwrap()
+        .clone();
+    for k in 0..130 {
+        parameters.push(Parameter {
+            name: format!("wedge_tx_{k}"),
+            ..wedge.clone()
+        });
+    }
+    let many = Arc::new(Scene::new(base.shapes().to_vec(), parameters, base.sensor()).unwrap());
+    let twins = estimate(Method::Transport, &base, 400_000, 71);
+    let walked = estimate(Method::Transport, &many, 400_000, 72);
+    for j in 0..base.parameters().len() {
+        let (a, b) = (get(&twins, &base, Some(j)), get(&walked, &many, Some(j)));
+        let z = (a.mean - b.mean) / (a.stderr.powi(2) + b.stderr.powi(2)).sqrt();
+        eprintln!(
+            "{}: twins {a:?}, walked {b:?}, z = {z:.2}",
+            base.parameters()[j].name
+        );
+        assert!(z.abs() < 4.0, "{}: z = {z:.2}", base.parameters()[j].name);
+    }
+    let first = walked.get(&Quantity::sensitivity("wedge_tx")).unwrap();
+    let copy = walked.get(&Quantity::sensitivity("wedge_tx_129")).unwrap();
+    assert_eq!(first.mean, copy.mean);
+}

@@ -17,8 +17,8 @@ use crate::estimator::within_rounding;
 use crate::rng::PathRng;
 
 /// Most derivative slots a walk carries (shape parameters, the sensor's
-/// gradient axes, and transport's twins of the parameters).
-pub const MAX_SLOTS: usize = 512;
+/// gradient axes, and transport's twins of the parameters when they fit).
+pub const MAX_SLOTS: usize = 256;
 
 /// A set of derivative slots, as bits.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -341,7 +341,7 @@ pub struct Slots {
     pub gradient_slots: SlotSet,
     /// Number of twin slots after the gradient axes: 0, or one per
     /// parameter (transport's frozen-scene continuations, see
-    /// [`Slots::twin`]).
+    /// [`Slots::twin`]; when `2 params + axes` fits in [`MAX_SLOTS`]).
     pub twins: usize,
     /// The twin slots.
     pub twin_slots: SlotSet,
@@ -364,7 +364,13 @@ impl Slots {
         for j in all.iter().filter(|&j| j >= params) {
             gradient_slots.insert(j);
         }
-        let twins = if twins { params } else { 0 };
+        // Twins only where they fit (up to 126 parameters): past that the
+        // nested walks they stand for are walked.
+        let twins = if twins && 2 * params + axes <= MAX_SLOTS {
+            params
+        } else {
+            0
+        };
         let mut twin_slots = SlotSet::EMPTY;
         for j in params + axes..params + axes + twins {
             twin_slots.insert(j);

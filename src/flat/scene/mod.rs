@@ -25,8 +25,8 @@ pub use validate::{MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE};
 pub const MAX_OPTICAL_THICKNESS: f64 = 1e4;
 
 /// Most parameters one path carries (with room for the sensor gradient's
-/// axes in 3D and, for transport, a twin slot per parameter): 253.
-pub const MAX_PARAMETERS: usize = (crate::path::deform::MAX_SLOTS - 6) / 2;
+/// axes in 3D): 253.
+pub const MAX_PARAMETERS: usize = crate::path::deform::MAX_SLOTS - 3;
 
 /// What happens to light arriving at a shape's boundary: the path core's
 /// surfaces (serialised through the file form in `repr`).
