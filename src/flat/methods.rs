@@ -105,8 +105,14 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
         names.push(Quantity::gradient("x"));
         names.push(Quantity::gradient("y"));
     }
+    // Transport's twins serve moving reflectors only (elsewhere they would
+    // be slots carried for nothing).
+    let twins = scheme == Scheme::Transport
+        && (0..scene.parameters().len()).any(|j| {
+            let k = scene.parameter_shape(j) as usize;
+            matches!(scene.shapes()[k].surface, super::Surface::Reflector { .. })
+        });
     let geometry = Plane::new(scene);
-    let twins = scheme == Scheme::Transport;
     let slots = Slots::new(&geometry, geometry.scene().shapes().len(), gradient, twins);
     DerivativeEstimator {
         geometry,

@@ -84,6 +84,11 @@ use crate::bvh_frame::{Primitive, Tree, scan_any, scan_closest};
 /// threshold scales with the scene.
 pub const T_MIN: f64 = 1e-12;
 
+/// Ulps of a triangle's largest coordinate below which a hit is the
+/// rounding of a point on it, not a hit ([`T_MIN`] for triangles far
+/// from the origin).
+pub const ROUNDING_ULPS: f64 = 64.0;
+
 /// Below this many (finite) triangles, [`TriangleBvh`] scans them instead
 /// of building a tree (see the [module docs](self#small-scenes)).
 pub const LINEAR_BELOW: usize = 4;
@@ -177,7 +182,13 @@ impl Shear {
             .length_squared()
             .max((tri[2] - tri[1]).length_squared())
             .max((tri[0] - tri[2]).length_squared());
-        (t > 0.0 && t * t * self.len2 > T_MIN * T_MIN * size2).then_some(t)
+        // Far from the origin the rounding of a point on the triangle (an
+        // origin on its edge, say) outgrows T_MIN times its size: the
+        // threshold is also ROUNDING_ULPS ulps of its coordinates.
+        let mag = tri[0].abs().max(tri[1].abs()).max(tri[2].abs()).max_element();
+        let floor = ROUNDING_ULPS * f64::EPSILON * mag;
+        let min2 = (T_MIN * T_MIN * size2).max(floor * floor);
+        (t > 0.0 && t * t * self.len2 > min2).then_some(t)
     }
 }
 

@@ -85,8 +85,15 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Spac
     }
     let shapes = scene.shapes().len();
     let caveats = kinks(&scene);
+    // Transport's twins serve moving reflectors only (elsewhere they would
+    // be slots carried for nothing).
+    let twins = scheme == Scheme::Transport
+        && (0..scene.parameters().len()).any(|j| {
+            let k = scene.parameter_shape(j) as usize;
+            matches!(scene.shapes()[k].surface, super::Surface::Reflector { .. })
+        });
     let geometry = Space::new(scene);
-    let slots = Slots::new(&geometry, shapes, gradient, scheme == Scheme::Transport);
+    let slots = Slots::new(&geometry, shapes, gradient, twins);
     DerivativeEstimator {
         geometry,
         slots,
