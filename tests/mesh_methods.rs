@@ -824,7 +824,10 @@ fn a_folded_occluder_far_from_the_origin_matches_the_closed_form() {
             assert!(i.z_score(e).abs() < 4.0, "{m} at {offset}: {i:?} vs {e}");
             let a = r.get(&Quantity::sensitivity("occ_tx")).unwrap();
             eprintln!("{m} at {offset}: {a:?} vs {exact}");
-            assert!(a.z_score(exact).abs() < 4.0, "{m} at {offset}: {a:?} vs {exact}");
+            assert!(
+                a.z_score(exact).abs() < 4.0,
+                "{m} at {offset}: {a:?} vs {exact}"
+            );
         }
     }
 }

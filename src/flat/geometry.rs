@@ -109,8 +109,13 @@ fn on_segment(s: &Segment, p: DVec2) -> bool {
 /// Signed area of a closed polygon (> 0 counter-clockwise).
 pub fn signed_area(vertices: &[DVec2]) -> f64 {
     let n = vertices.len();
+    let Some(&o) = vertices.first() else {
+        return 0.0;
+    };
+    // About the first vertex: far from the origin the products of absolute
+    // coordinates would cancel to nothing.
     0.5 * (0..n)
-        .map(|i| cross(vertices[i], vertices[(i + 1) % n]))
+        .map(|i| cross(vertices[i] - o, vertices[(i + 1) % n] - o))
         .sum::<f64>()
 }
 

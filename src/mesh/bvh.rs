@@ -185,7 +185,11 @@ impl Shear {
         // Far from the origin the rounding of a point on the triangle (an
         // origin on its edge, say) outgrows T_MIN times its size: the
         // threshold is also ROUNDING_ULPS ulps of its coordinates.
-        let mag = tri[0].abs().max(tri[1].abs()).max(tri[2].abs()).max_element();
+        let mag = tri[0]
+            .abs()
+            .max(tri[1].abs())
+            .max(tri[2].abs())
+            .max_element();
         let floor = ROUNDING_ULPS * f64::EPSILON * mag;
         let min2 = (T_MIN * T_MIN * size2).max(floor * floor);
         (t > 0.0 && t * t * self.len2 > min2).then_some(t)

@@ -18,7 +18,7 @@ mod repr;
 mod tests;
 mod validate;
 
-pub use validate::{MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE};
+pub use validate::{MAX_OFFSET, MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE};
 
 /// Largest extinction coefficient times scene size accepted: beyond it a
 /// medium is opaque for every purpose and the weights underflow.

@@ -22,8 +22,8 @@
 use super::crossings::{Aabb, check_crossings};
 use super::geometry::{point_triangle_distance, signed_volume, winding_number};
 use super::{
-    MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE, Medium, Motion, Parameter, Scene,
-    Sensor, Shape, Surface,
+    MAX_OFFSET, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE, Medium, Motion,
+    Parameter, Scene, Sensor, Shape, Surface,
 };
 use crate::error::{Error, Num};
 use crate::flat::scene::MAX_SCATTERING_EVENTS;
@@ -269,6 +269,15 @@ fn scene_size(shapes: &[Shape]) -> Result<f64, Error> {
             "the scene's size (largest extent of its vertices' bounding box) is {size:e}: \
              sizes from {MIN_SIZE:e} to {MAX_SIZE:e} are supported; rescale the scene \
              (only κ × size and ratios of lengths matter)"
+        ));
+    }
+    let far = lo.abs().max(hi.abs()).max_element();
+    if far > MAX_OFFSET * size {
+        return config(format!(
+            "the scene lies {far:e} from the origin, {:.1e} times its size {size:e}: \
+             at most {MAX_OFFSET:e} times is supported (farther, its coordinates keep \
+             too few digits of its geometry); move the scene nearer the origin",
+            far / size
         ));
     }
     Ok(size)
