@@ -441,6 +441,15 @@ fn transport_with_and_without_twins_agrees() {
         );
         assert!(z.abs() < 4.0, "{}: z = {z:.2}", base.parameters()[j].name);
     }
+    // The two runs took the two routes: twins where a parameter moves a
+    // reflector and they fit, none past 126 parameters, nor without a
+    // moving reflector.
+    use geosens::flat::methods::derivative;
+    use geosens::path::estimator::Scheme;
+    let twins = |s: &Arc<Scene>| derivative(s.clone(), Scheme::Transport).slots.twins;
+    assert_eq!(twins(&base), base.parameters().len());
+    assert_eq!(twins(&many), 0);
+    assert_eq!(twins(&scene("occluder.toml")), 0);
     let first = walked.get(&Quantity::sensitivity("wedge_tx")).unwrap();
     let copy = walked.get(&Quantity::sensitivity("wedge_tx_129")).unwrap();
     assert_eq!(first.mean, copy.mean);
