@@ -95,7 +95,8 @@ fn unit(what: &str, v: DVec2) -> Result<DVec2, Error> {
 }
 
 /// Checks every shape on its own ([`check_shape`]) and returns the scene's
-/// size: the largest extent of the vertices' bounding box.
+/// size: the largest extent of the vertices' bounding box
+/// ([`check_extent`]).
 fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
     if shapes.is_empty() {
         return config("a scene needs at least one shape".into());
@@ -112,7 +113,17 @@ fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
         lo = lo.min(v);
         hi = hi.max(v);
     }
-    let size = (hi - lo).max_element();
+    check_extent(
+        (hi - lo).max_element(),
+        lo.abs().max(hi.abs()).max_element(),
+    )
+}
+
+/// A scene's size (the largest extent of its vertices' bounding box) within
+/// [`MIN_SIZE`]..[`MAX_SIZE`], and `far`, its farthest coordinate from the
+/// origin, within [`MAX_OFFSET`] times it; returns the size. Flatland's
+/// and 3D's validation both.
+pub(crate) fn check_extent(size: f64, far: f64) -> Result<f64, Error> {
     if !(MIN_SIZE..=MAX_SIZE).contains(&size) {
         return config(format!(
             "the scene's size (largest extent of its vertices' bounding box) is {size:e}: \
@@ -120,7 +131,6 @@ fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
              (only κ × size and ratios of lengths matter)"
         ));
     }
-    let far = lo.abs().max(hi.abs()).max_element();
     if far > MAX_OFFSET * size {
         return config(format!(
             "the scene lies {far:e} from the origin, {:.1e} times its size {size:e}: \

@@ -7,7 +7,8 @@
 //! 1. each shape as given: name, triangle indices, finite coordinates,
 //!    surface and medium numbers ([`check_shape`]);
 //! 2. welding by exact position, dropping unused vertices ([`weld`]);
-//! 3. the scene's size ([`MIN_SIZE`]..[`MAX_SIZE`]);
+//! 3. the scene's size ([`MIN_SIZE`](super::MIN_SIZE)..[`MAX_SIZE`](super::MAX_SIZE)) and
+//!    its distance from the origin ([`MAX_OFFSET`](super::MAX_OFFSET));
 //! 4. each mesh's triangles and edges: degenerate triangles, non-manifold
 //!    edges, orientation, closedness ([`topology`]);
 //! 5. meshes that cross or touch (`crossings`);
@@ -22,8 +23,7 @@
 use super::crossings::{Aabb, check_crossings};
 use super::geometry::{point_triangle_distance, signed_volume, winding_number};
 use super::{
-    MAX_OFFSET, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE, Medium, Motion,
-    Parameter, Scene, Sensor, Shape, Surface,
+    MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion, Parameter, Scene, Sensor, Shape, Surface,
 };
 use crate::error::{Error, Num};
 use crate::flat::scene::MAX_SCATTERING_EVENTS;
@@ -91,7 +91,8 @@ impl Scene {
     /// on an open or opaque mesh, a transparent mesh without a medium,
     /// coefficients out of range (κs < 0, κe < κs, |g| ≥ 1, radiance < 0,
     /// albedo ∉ `[0, 1]`), a medium too thick ([`MAX_OPTICAL_THICKNESS`]), a
-    /// size outside [`MIN_SIZE`]..[`MAX_SIZE`], two meshes that cross or
+    /// size outside [`MIN_SIZE`](super::MIN_SIZE)..[`MAX_SIZE`](super::MAX_SIZE) or
+    /// too far from the origin ([`MAX_OFFSET`](super::MAX_OFFSET)), two meshes that cross or
     /// touch ([`TOUCH_DISTANCE`]), bad parameters (too many, empty or
     /// repeated names, unknown shapes, zero or non-finite axes and pivots),
     /// a non-finite sensor, a sensor on a surface or inside an opaque closed
@@ -256,31 +257,18 @@ pub(super) fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
 }
 
 /// The largest extent of the vertices' bounding box, within
-/// [`MIN_SIZE`]..[`MAX_SIZE`].
+/// [`MIN_SIZE`](super::MIN_SIZE)..[`MAX_SIZE`](super::MAX_SIZE), no farther
+/// from the origin than [`MAX_OFFSET`](super::MAX_OFFSET) times it.
 fn scene_size(shapes: &[Shape]) -> Result<f64, Error> {
     let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
     for s in shapes {
         let (l, h) = bounds(&s.vertices);
         (lo, hi) = (lo.min(l), hi.max(h));
     }
-    let size = (hi - lo).max_element();
-    if !(MIN_SIZE..=MAX_SIZE).contains(&size) {
-        return config(format!(
-            "the scene's size (largest extent of its vertices' bounding box) is {size:e}: \
-             sizes from {MIN_SIZE:e} to {MAX_SIZE:e} are supported; rescale the scene \
-             (only κ × size and ratios of lengths matter)"
-        ));
-    }
-    let far = lo.abs().max(hi.abs()).max_element();
-    if far > MAX_OFFSET * size {
-        return config(format!(
-            "the scene lies {far:e} from the origin, {:.1e} times its size {size:e}: \
-             at most {MAX_OFFSET:e} times is supported (farther, its coordinates keep \
-             too few digits of its geometry); move the scene nearer the origin",
-            far / size
-        ));
-    }
-    Ok(size)
+    crate::flat::scene::check_extent(
+        (hi - lo).max_element(),
+        lo.abs().max(hi.abs()).max_element(),
+    )
 }
 
 /// The triangles using one edge (at most two: a third is an error).
