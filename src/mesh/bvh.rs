@@ -101,7 +101,27 @@ pub const LINEAR_BELOW: usize = 4;
 /// through the edge hits at least one; see the [module docs](self).
 #[inline]
 pub fn intersect(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<f64> {
-    Shear::new(origin, dir).hit(tri)
+    Shear::new(origin, dir).hit(tri, nearest_hit2(tri))
+}
+
+/// The square of the least distance (times `|dir|`) at which a ray hits
+/// `tri`: [`T_MIN`] times its longest edge, and at least `ROUNDING_ULPS`
+/// ulps of its largest coordinate (far from the origin the rounding of a
+/// point on the triangle, an origin on its edge say, outgrows the first).
+/// Fixed per triangle, so the casters keep it beside the triangle.
+#[inline]
+fn nearest_hit2(tri: &[DVec3; 3]) -> f64 {
+    let size2 = (tri[1] - tri[0])
+        .length_squared()
+        .max((tri[2] - tri[1]).length_squared())
+        .max((tri[0] - tri[2]).length_squared());
+    let mag = tri[0]
+        .abs()
+        .max(tri[1].abs())
+        .max(tri[2].abs())
+        .max_element();
+    let floor = ROUNDING_ULPS * f64::EPSILON * mag;
+    (T_MIN * T_MIN * size2).max(floor * floor)
 }
 
 /// A query ray prepared for [`intersect`]: the shear that takes it to the
@@ -158,9 +178,9 @@ impl Shear {
         (p.dot(self.ex), p.dot(self.ey), p.dot(self.ez))
     }
 
-    /// The test of [`intersect`].
+    /// The test of [`intersect`], `min2` the triangle's [`nearest_hit2`].
     #[inline(always)]
-    fn hit(&self, tri: &[DVec3; 3]) -> Option<f64> {
+    fn hit(&self, tri: &[DVec3; 3], min2: f64) -> Option<f64> {
         let (ax, ay, az) = self.project(tri[0]);
         let (bx, by, bz) = self.project(tri[1]);
         let (cx, cy, cz) = self.project(tri[2]);
@@ -178,20 +198,6 @@ impl Shear {
             return None; // parallel ray or degenerate triangle
         }
         let t = (u * az + v * bz + w * cz) / det;
-        let size2 = (tri[1] - tri[0])
-            .length_squared()
-            .max((tri[2] - tri[1]).length_squared())
-            .max((tri[0] - tri[2]).length_squared());
-        // Far from the origin the rounding of a point on the triangle (an
-        // origin on its edge, say) outgrows T_MIN times its size: the
-        // threshold is also ROUNDING_ULPS ulps of its coordinates.
-        let mag = tri[0]
-            .abs()
-            .max(tri[1].abs())
-            .max(tri[2].abs())
-            .max_element();
-        let floor = ROUNDING_ULPS * f64::EPSILON * mag;
-        let min2 = (T_MIN * T_MIN * size2).max(floor * floor);
         (t > 0.0 && t * t * self.len2 > min2).then_some(t)
     }
 }
@@ -200,6 +206,8 @@ impl Shear {
 #[derive(Debug, Clone, Copy)]
 struct Prim {
     tri: [DVec3; 3],
+    /// [`nearest_hit2`] of `tri`.
+    min2: f64,
     id: u32,
 }
 
@@ -209,7 +217,11 @@ fn finite_prims(triangles: Vec<[DVec3; 3]>) -> Vec<Prim> {
         .into_iter()
         .enumerate()
         .filter(|(_, t)| t.iter().all(|v| v.is_finite()))
-        .map(|(i, tri)| Prim { tri, id: i as u32 })
+        .map(|(i, tri)| Prim {
+            tri,
+            min2: nearest_hit2(&tri),
+            id: i as u32,
+        })
         .collect()
 }
 
@@ -224,7 +236,7 @@ impl Primitive for Prim {
 
     #[inline(always)]
     fn hit(&self, ray: &Shear) -> Option<f64> {
-        ray.hit(&self.tri)
+        ray.hit(&self.tri, self.min2)
     }
 
     #[inline]
