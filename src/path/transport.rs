@@ -141,10 +141,10 @@ impl<G: Boundaries> Transport<'_, G> {
     /// The path's state with each twin's derivative added to its
     /// parameter's.
     pub fn finish(mut self) -> Deform<G::V> {
-        for j in self.slots.parameter_slots.iter() {
-            let t = self.slots.twin(j);
-            if t < self.d.len() && self.slots.twins > 0 {
-                let (b, scale) = (self.d.slots[t].boundary, self.d.slots[t].boundary_scale);
+        if self.slots.twins > 0 {
+            for j in self.slots.parameter_slots.iter() {
+                let t = &self.d.slots[self.slots.twin(j)];
+                let (b, scale) = (t.boundary, t.boundary_scale);
                 self.d.slots[j].add_boundary(b, scale);
             }
         }
