@@ -14,8 +14,9 @@
 //! emitter points (their position along the emitters, uniform by length,
 //! and their direction seen from a point against `light_pdf`), and the
 //! corner selection of rendering's boundary term (`sample_boundary`: each
-//! corner's frequency against weight / total, and `inv_pdf` equal to
-//! total / weight). Where a warp has a closed-form inverse (the cosine
+//! corner's frequency against its density, a mixture with one component per
+//! slot of weight / total over the corners that move for it, and `inv_pdf`
+//! equal to one over it). Where a warp has a closed-form inverse (the cosine
 //! lobe's `θ = asin(2u − 1)`, the wrapped Cauchy law's inverse CDF, the
 //! isotropic `θ = 2πu`), a round-trip test maps the drawn direction back to
 //! the uniform number the sampler consumed, to 10⁻¹².
@@ -30,8 +31,9 @@ use geosens::flat::geometry::{Segment, cross, direction, perp};
 use geosens::flat::lobe::FlatLobe;
 use geosens::flat::space::Plane;
 use geosens::flat::{Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface};
+use geosens::path::deform::SlotSet;
 use geosens::path::walk::{Frame, Vertex};
-use geosens::path::{Boundaries, Geometry, Lobe};
+use geosens::path::{Boundaries, BoundaryView, Geometry, Lobe};
 use geosens::rng::{PathRng, free_path, stream};
 use glam::DVec2;
 use rand::RngExt;
@@ -592,11 +594,59 @@ fn corners_are_drawn_by_weight() {
             .iter()
             .any(|&(q, w, _)| q == DVec2::new(0.0, 2.5) && w < 1e-15)
     );
-    for all in [true, false] {
-        let share = |&(_, w, m): &(DVec2, f64, bool)| if all || m { w } else { 0.0 };
-        let total: f64 = weights.iter().map(share).sum();
+    // The draws are shared out equally among the view's slots: a slot
+    // that sees all corners move draws among all of them by weight, a
+    // parameter among its own shape's (none for the fog's: it has no
+    // corner). Slot 3 stands for a gradient slot.
+    let slots = |js: &[usize]| {
+        let mut s = SlotSet::EMPTY;
+        for &j in js {
+            s.insert(j);
+        }
+        s
+    };
+    let views = [
+        ("all corners", slots(&[3]), SlotSet::EMPTY),
+        ("moving corners", SlotSet::EMPTY, slots(&[0, 1, 2])),
+        ("a mixture", slots(&[3]), slots(&[0, 1])),
+        ("one shape", SlotSet::EMPTY, slots(&[1, 2])),
+    ];
+    for (name, all, own) in views {
+        let view = BoundaryView { all, own };
+        // The components: `None` for all corners, else a shape.
+        let mut components: Vec<Option<u32>> = all.iter().map(|_| None).collect();
+        for j in own.iter() {
+            let k = scene.parameter_shape(j);
+            if weights
+                .iter()
+                .zip(scene.corners())
+                .any(|(w, c)| c.1 == k && w.1 > 0.0)
+            {
+                components.push(Some(k));
+            }
+        }
+        let in_component = |i: usize, c: Option<u32>| c.is_none_or(|k| scene.corners()[i].1 == k);
+        let pdf: Vec<f64> = (0..weights.len())
+            .map(|i| {
+                components
+                    .iter()
+                    .map(|&c| {
+                        let total: f64 = (0..weights.len())
+                            .filter(|&m| in_component(m, c))
+                            .map(|m| weights[m].1)
+                            .sum();
+                        if in_component(i, c) {
+                            weights[i].1 / total
+                        } else {
+                            0.0
+                        }
+                    })
+                    .sum::<f64>()
+                    / components.len() as f64
+            })
+            .collect();
         let mut counts = vec![0u64; weights.len()];
-        let mut rng = stream(800 + u64::from(all), 0);
+        let mut rng = stream(800 + components.len() as u64, all.len() as u64);
         let v = Vertex::<Plane> {
             x: DVec2::ZERO,
             medium: None,
@@ -612,24 +662,19 @@ fn corners_are_drawn_by_weight() {
             mixed: false,
         };
         for _ in 0..N {
-            let b = plane.sample_boundary(&v, all, rng.random()).unwrap();
+            let b = plane.sample_boundary(&v, &view, rng.random()).unwrap();
             let i = b.index as usize;
             assert_eq!((b.q, b.shape), scene.corners()[i]);
-            let w = share(&weights[i]);
-            assert!(w > 0.0, "corner {i} of weight 0 drawn (all = {all})");
+            assert!(pdf[i] > 0.0, "corner {i} of probability 0 drawn ({name})");
             assert!(
-                (b.inv_pdf - total / w).abs() <= 1e-12 * b.inv_pdf,
-                "corner {i}: inv_pdf {} for total/weight {}",
+                (b.inv_pdf - 1.0 / pdf[i]).abs() <= 1e-12 * b.inv_pdf,
+                "corner {i}: inv_pdf {} for 1/pdf {} ({name})",
                 b.inv_pdf,
-                total / w
+                1.0 / pdf[i]
             );
             counts[i] += 1;
         }
-        let expected: Vec<f64> = weights
-            .iter()
-            .map(|c| N as f64 * share(c) / total)
-            .collect();
-        let name = if all { "all corners" } else { "moving corners" };
+        let expected: Vec<f64> = pdf.iter().map(|p| N as f64 * p).collect();
         assert_fits(name, &counts, &expected);
     }
 }

@@ -11,7 +11,7 @@ use super::scene::{Phase, Sensor as FlatSensor};
 use super::space::{Knot, Plane};
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, Hit, NO_PRIM, Side};
+use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, NO_PRIM, Side};
 use glam::DVec2;
 use std::f64::consts::TAU;
 
@@ -33,14 +33,24 @@ pub struct FlatWarp {
 }
 
 impl Boundaries for Plane {
+    // ANCHOR: sample_boundary
+    /// A corner drawn by weight, the draws shared out equally among the
+    /// slots of `view` (a mixture): a slot that sees every corner move
+    /// draws among all of them, a shape parameter among its shape's (a
+    /// binary search in cumulative weights either way). A few moving
+    /// corners among many that move for one parameter only are then drawn
+    /// as often as their parameters need, not by their share of the weight.
     #[inline]
-    /// A corner drawn with probability proportional to its weight (a binary
-    /// search in the cumulative weights).
-    fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec2>> {
+    fn sample_boundary(
+        &self,
+        v: &Vertex<Self>,
+        view: &BoundaryView,
+        u: f64,
+    ) -> Option<BoundaryPoint<DVec2>> {
         if let FlatLobe::Pixel { x0, x1, .. } = v.lobe {
             // A camera stands still: the moving corners seen through the
             // stratum, drawn uniformly.
-            debug_assert!(!all, "a camera does not move");
+            debug_assert!(!view.sees_all(), "a camera does not move");
             let list = self.camera_corner_list();
             let lo = list.partition_point(|c| c.0 < x0);
             let hi = list.partition_point(|c| c.0 <= x1);
@@ -57,28 +67,80 @@ impl Boundaries for Plane {
                 inv_pdf: n as f64,
             });
         }
-        let cdf = if all { &self.all_cdf } else { &self.moving_cdf };
-        let total = *cdf.last()?;
-        if total <= 0.0 {
+        let total = self.all_cdf.last().copied().unwrap_or(0.0);
+        // The mixture's components: every slot that sees all corners move
+        // draws among all (if any weighs), every parameter whose shape has
+        // corners that weigh among those; the shape of each parameter's
+        // component, and whether they are all one.
+        let n_all = if total > 0.0 { view.all.len() } else { 0 };
+        let own_shape = |j: usize| {
+            let k = self.scene.parameter_shape(j);
+            (self.shape_weight(k) > 0.0).then_some(k)
+        };
+        let mut n_own = 0usize;
+        let mut single = None;
+        let mut mixed = false;
+        for k in view.own.iter().filter_map(own_shape) {
+            n_own += 1;
+            match single {
+                None => single = Some(k),
+                Some(s) => mixed |= s != k,
+            }
+        }
+        mixed |= n_all > 0 && n_own > 0;
+        let n = n_all + n_own;
+        if n == 0 {
             return None;
         }
+        // The component, and a fresh uniform number within it.
+        let (component, u) = if !mixed {
+            (single, u)
+        } else {
+            let r = u * n as f64;
+            let i = (r as usize).min(n - 1);
+            let u = (r - i as f64).clamp(0.0, 1.0);
+            if i < n_all {
+                (None, u)
+            } else {
+                (view.own.iter().filter_map(own_shape).nth(i - n_all), u)
+            }
+        };
+        let (cdf, first) = match component {
+            None => (&self.all_cdf[..], 0),
+            Some(k) => {
+                let (start, end) = self.shape_corners[k as usize];
+                (&self.shape_cdf[start as usize..end as usize], start)
+            }
+        };
+        let w_total = *cdf.last()?;
         // Below the total even when u·total rounds up to it, so that a
         // corner of weight 0 at the end is never picked.
-        let s = (u * total).min(total * (1.0 - f64::EPSILON));
+        let s = (u * w_total).min(w_total * (1.0 - f64::EPSILON));
         let pick = cdf.partition_point(|&c| c <= s).min(cdf.len() - 1);
-        let index = if all {
-            pick as u32
-        } else {
-            self.moving_corners[pick]
-        };
+        let index = first + pick as u32;
         let (q, shape) = self.scene.corners()[index as usize];
+        let w = self.corner_weight[index as usize];
+        let inv_pdf = if !mixed {
+            w_total / w
+        } else {
+            // Every component that holds the corner.
+            let n_shape = view
+                .own
+                .iter()
+                .filter(|&j| own_shape(j) == Some(shape))
+                .count();
+            let p_all = if n_all > 0 { n_all as f64 / total } else { 0.0 };
+            let p_shape = n_shape as f64 / self.shape_weight(shape);
+            n as f64 / (w * (p_all + p_shape))
+        };
         Some(BoundaryPoint {
             q,
             shape,
             index,
-            inv_pdf: total / self.corner_weight[index as usize],
+            inv_pdf,
         })
     }
+    // ANCHOR_END: sample_boundary
 
     // ANCHOR: sides
     /// The segments at the corner that lie on either side of the sight line

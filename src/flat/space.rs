@@ -28,9 +28,12 @@ pub struct Plane {
     /// share of viewpoints from which it is a silhouette; two collinear
     /// faces of one surface have no jump at all).
     pub(super) corner_weight: Vec<f64>,
-    /// Cumulative weights over all corners, and over the moving ones.
+    /// Cumulative weights over all corners.
     pub(super) all_cdf: Vec<f64>,
-    pub(super) moving_cdf: Vec<f64>,
+    /// Per corner, the cumulative weight over its shape's corners up to it.
+    pub(super) shape_cdf: Vec<f64>,
+    /// Per shape, its corners `start..end` (empty for a transparent one).
+    pub(super) shape_corners: Vec<(u32, u32)>,
     /// The corners visible from an irradiance sensor in front of it, by
     /// angle from +x: the warp's knots there, the same for every path
     /// (found on first use: only the expectation method asks).
@@ -127,17 +130,40 @@ impl Plane {
             .collect::<Vec<f64>>()
         };
         let all_cdf = cdf(&mut (0..corner_weight.len()));
-        let moving_cdf = cdf(&mut moving_corners.iter().map(|&i| i as usize));
+        let mut shape_corners = vec![(0u32, 0u32); scene.shapes().len()];
+        for (i, c) in scene.corners().iter().enumerate() {
+            let r = &mut shape_corners[c.1 as usize];
+            if r.1 == 0 {
+                r.0 = i as u32;
+            }
+            r.1 = i as u32 + 1;
+        }
+        let mut shape_cdf = Vec::with_capacity(corner_weight.len());
+        for &(start, end) in &shape_corners {
+            shape_cdf.extend(cdf(&mut (start as usize..end as usize)));
+        }
         Plane {
             scene,
             corner_segments,
             moving_corners,
             corner_weight,
             all_cdf,
-            moving_cdf,
+            shape_cdf,
+            shape_corners,
             sensor_knots: OnceLock::new(),
             sensor_gaps: OnceLock::new(),
             camera_corners: OnceLock::new(),
+        }
+    }
+
+    /// The total corner weight of shape `k` (0 for a transparent one).
+    #[inline]
+    pub(super) fn shape_weight(&self, k: u32) -> f64 {
+        let (start, end) = self.shape_corners[k as usize];
+        if end > start {
+            self.shape_cdf[end as usize - 1]
+        } else {
+            0.0
         }
     }
 

@@ -41,7 +41,7 @@ use super::space::Space;
 use super::warp::SpaceWarp;
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, Hit, NO_PRIM, Prim, Side};
+use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, NO_PRIM, Prim, Side};
 use crate::rng::PathRng;
 use glam::DVec3;
 use rand::RngExt;
@@ -620,7 +620,13 @@ impl Boundaries for Space {
     /// (`Space::edge_points`); `inv_pdf` is per unit arc length on the
     /// sphere of directions.
     #[inline]
-    fn sample_boundary(&self, v: &Vertex<Self>, all: bool, u: f64) -> Option<BoundaryPoint<DVec3>> {
+    fn sample_boundary(
+        &self,
+        v: &Vertex<Self>,
+        view: &BoundaryView,
+        u: f64,
+    ) -> Option<BoundaryPoint<DVec3>> {
+        let all = view.sees_all();
         if let SpaceLobe::Pixel { rect, pixel, .. } = v.lobe {
             // The camera stands still: only moving edges move across a
             // pixel (`all` cannot be set there).
@@ -638,10 +644,11 @@ impl Boundaries for Space {
     fn boundary_points(
         &self,
         v: &Vertex<Self>,
-        all: bool,
+        view: &BoundaryView,
         rng: &mut PathRng,
         mut f: impl FnMut(&mut PathRng, BoundaryPoint<DVec3>),
     ) {
+        let all = view.sees_all();
         if let SpaceLobe::Pixel { rect, pixel, .. } = v.lobe {
             debug_assert!(!all, "a camera does not move");
             let u: f64 = rng.random();

@@ -75,6 +75,22 @@ impl SlotSet {
         s
     }
 
+    /// The slots of `self` not in `o`.
+    #[inline]
+    pub fn without(self, o: SlotSet) -> SlotSet {
+        let mut s = self;
+        for (a, b) in s.0.iter_mut().zip(o.0) {
+            *a &= !b;
+        }
+        s
+    }
+
+    /// Number of slots in the set.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.0.iter().map(|w| w.count_ones() as usize).sum()
+    }
+
     /// The slots in the set, in increasing order.
     #[inline]
     pub fn iter(self) -> impl Iterator<Item = usize> {

@@ -335,18 +335,40 @@ pub enum Side {
     Past,
 }
 
+/// Whom the boundary term at a vertex serves, as the draw of its boundary
+/// point needs to know: a slot whose vertex or frame moves sees every
+/// discontinuity move; a shape parameter otherwise sees only its own
+/// shape's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BoundaryView {
+    /// The slots whose vertex or frame moves at the vertex.
+    pub all: deform::SlotSet,
+    /// The shape parameters not in `all` (their own shapes' discontinuities
+    /// move).
+    pub own: deform::SlotSet,
+}
+
+impl BoundaryView {
+    /// Whether some slot sees every discontinuity move.
+    #[inline]
+    pub fn sees_all(&self) -> bool {
+        !self.all.is_empty()
+    }
+}
+
 /// Where the integrand over directions jumps, and the warp that follows
 /// those jumps: the discontinuity machinery of a geometry.
 pub trait Boundaries: Geometry {
     /// Draws one boundary point for the directional integral at `v` (see
-    /// [`Boundaries::boundary_points`] for all of them):
-    /// among all of them when the vertex or its frame moves (`all`), else
-    /// among those of moving shapes; at a camera, among those inside the
-    /// stratum's footprint (where `v`'s lobe is not 0).
+    /// [`Boundaries::boundary_points`] for all of them), among those that
+    /// move for some slot of `view`: all of them for a slot whose vertex or
+    /// frame moves, else those of the shapes its parameter moves (a
+    /// geometry may share the draws out per slot); at a camera, among those
+    /// inside the stratum's footprint (where `v`'s lobe is not 0).
     fn sample_boundary(
         &self,
         v: &walk::Vertex<Self>,
-        all: bool,
+        view: &BoundaryView,
         u: f64,
     ) -> Option<BoundaryPoint<Self::V>>
     where
@@ -362,14 +384,14 @@ pub trait Boundaries: Geometry {
     fn boundary_points(
         &self,
         v: &walk::Vertex<Self>,
-        all: bool,
+        view: &BoundaryView,
         rng: &mut crate::rng::PathRng,
         mut f: impl FnMut(&mut crate::rng::PathRng, BoundaryPoint<Self::V>),
     ) where
         Self: Sized,
     {
         use rand::RngExt;
-        if let Some(b) = self.sample_boundary(v, all, rng.random()) {
+        if let Some(b) = self.sample_boundary(v, view, rng.random()) {
             f(rng, b);
         }
     }

@@ -20,7 +20,10 @@
 //! "Rendering" and "Corner jumps".
 use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
 use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance};
-use super::{Boundaries, BoundaryPoint, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface, Vector};
+use super::{
+    Boundaries, BoundaryPoint, BoundaryView, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface,
+    Vector,
+};
 use crate::rng::PathRng;
 
 /// The rendering method's hooks: one walk's deformation state.
@@ -158,11 +161,18 @@ pub(super) fn corner_jump<G: Boundaries>(
             moving_view.insert(j);
         }
     }
-    let all = !moving_view.is_empty();
-    if !all && frozen {
+    let view = BoundaryView {
+        all: moving_view,
+        own: if frozen {
+            SlotSet::EMPTY
+        } else {
+            slots.parameter_slots.without(moving_view)
+        },
+    };
+    if view.all.is_empty() && view.own.is_empty() {
         return;
     }
-    g.boundary_points(v, all, rng, |rng, b| {
+    g.boundary_points(v, &view, rng, |rng, b| {
         corner_term(g, slots, d, rng, v, frozen, moving_view, &b)
     });
 }
