@@ -29,6 +29,14 @@
 //!   (over a larger tree: half the time uniform on the arc, half on its
 //!   lamp parts, the density the mixture's).
 //!
+//! Which edges: all of them for a slot whose vertex or frame moves, a
+//! parameter's own mesh's otherwise. When both kinds of slot, or the
+//! parameters of several meshes, meet at a vertex, the edges are split
+//! into strata (one per such mesh, and the rest): every stratum's points
+//! taken every time are taken, and the one drawn point comes from a
+//! stratum drawn in proportion to the slots it serves
+//! (`Space::edge_strata`).
+//!
 //! Each point's `inv_pdf` is the inverse of its density per unit arc
 //! length (a point taken every time: of its position alone), so the path
 //! core's corner term (`rendering::corner_jump`) is, unchanged, the edge
@@ -73,6 +81,30 @@ impl Space {
 /// pixels of the standard errors by 19 % (cube_x's by 1 %) for 15 % more
 /// time per path; 4 cut it further but cost more than they saved.
 const SET_POINTS: usize = 2;
+
+/// The edges a boundary term covers: all of them, those of the moving
+/// meshes, or one mesh's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Stratum {
+    /// Every edge.
+    All,
+    /// The edges of the meshes some parameter moves.
+    Moving,
+    /// The edges of mesh `k`.
+    Shape(u32),
+}
+
+/// How a boundary term covers its edges ([`Space::edge_strata`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Strata {
+    /// No edge moves for any slot.
+    None,
+    /// One stratum covers them all.
+    One(Stratum),
+    /// One stratum per mesh of the own parameters, and the rest if some
+    /// slot (`n_all` of them) sees every edge move.
+    Mixed { n_all: usize },
+}
 
 /// The fractions `(i + u) / SET_POINTS`, `i < SET_POINTS`.
 #[inline]
@@ -406,12 +438,13 @@ impl Space {
     }
 
     // ANCHOR: edge_point
-    /// The boundary points of the directional integral at `x` (over all
-    /// edges if `all`, else the moving meshes'), each with `inv_pdf` per
-    /// unit arc length on the sphere, passed to `f`:
+    /// The boundary points of the directional integral at `x` over the
+    /// edges of `stratum`, each with `inv_pdf` per unit arc length on the
+    /// sphere, passed to `f`:
     ///
-    /// - one drawn from the tree of the edges but the lamps' ([`Space::
-    ///   drawn_point`], `u_draw`);
+    /// - with `draw = (u_draw, share)`, one drawn from the tree of the
+    ///   edges but the lamps' ([`Space::drawn_point`]), its density times
+    ///   `share` (the probability the stratum's point is drawn at all);
     /// - when the tree holds at most [`LAMP_EDGES`] edges, [`SET_POINTS`]
     ///   on the lamp parts of each silhouette that has a lamp behind part
     ///   of its arc (uniform on them, stratified by `u_set`), the drawn
@@ -420,21 +453,28 @@ impl Space {
     ///   stratified by `u_set`).
     ///
     /// Every point of every discontinuity is covered by exactly one of
-    /// these, with the density reported: the sum is unbiased.
+    /// these, with the density reported: the sum is unbiased. Only the
+    /// edges of meshes `keep` holds give points (the others are left
+    /// before any work on their lamp parts).
     #[inline]
     fn edge_points(
         &self,
         x: DVec3,
-        all: bool,
-        u_draw: f64,
+        stratum: Stratum,
+        draw: Option<(f64, f64)>,
         u_set: f64,
+        keep: impl Fn(u32) -> bool,
         mut f: impl FnMut(BoundaryPoint<DVec3>),
     ) {
         let tables = self.edge_tables();
-        let (tree, apart, overlap, lamp_total) = self.drawn_tree(x, all);
+        let (tree, apart, overlap, lamp_total) = self.drawn_tree(x, stratum);
         let ids = tree.edges();
-        if let Some(b) = self.drawn_point(x, tree, apart.then_some(&overlap), u_draw) {
-            f(b);
+        if let Some((u_draw, share)) = draw
+            && let Some(b) = self.drawn_point(x, tree, apart.then_some(&overlap), u_draw)
+            && keep(b.shape)
+        {
+            let inv_pdf = b.inv_pdf / share;
+            f(BoundaryPoint { inv_pdf, ..b });
         }
         if lamp_total > 0.0 {
             for (k, &o) in overlap[..ids.len()].iter().enumerate() {
@@ -443,6 +483,9 @@ impl Space {
                 }
                 let index = ids[k];
                 let edge = &tables.edges[index as usize];
+                if !keep(edge.shape) {
+                    continue;
+                }
                 let Some(arc) = EdgeArc::new(edge, x) else {
                     continue;
                 };
@@ -465,7 +508,7 @@ impl Space {
             }
         }
         for u in stratified(u_set) {
-            self.lamp_edge_points(x, all, u, |b| {
+            self.lamp_edge_points(x, stratum, u, &keep, |b| {
                 f(BoundaryPoint {
                     inv_pdf: b.inv_pdf / SET_POINTS as f64,
                     ..b
@@ -474,6 +517,122 @@ impl Space {
         }
     }
 
+    // ANCHOR: edge_strata
+    /// How the boundary term at a vertex splits its edges (see
+    /// [`BoundaryView`]): a slot whose vertex or frame moves needs every
+    /// edge, a parameter only its own mesh's. With one kind of need, one
+    /// stratum as before (all edges; the moving meshes' when one mesh's
+    /// parameters are all that need them). Otherwise the edges are split
+    /// into strata, one per mesh moved by a parameter of `view.own`, and
+    /// the rest (every other edge, if some slot sees all move), and one
+    /// stratum is drawn per term ([`Space::pick_stratum`]): a few edges of
+    /// a small moving mesh then get the draws their parameters need, not
+    /// their share of the estimated contribution among thousands.
+    #[inline]
+    pub(super) fn edge_strata(&self, view: &BoundaryView) -> Strata {
+        let tables = self.edge_tables();
+        let n_all = view.all.len();
+        // Meshes of own parameters that have edges: count them (each once,
+        // at its first own parameter).
+        let mut n_own = 0;
+        let mut single = None;
+        for j in view.own.iter() {
+            let k = self.scene.parameter_shape(j);
+            let first = view.own.and(self.shape_params[k as usize]).iter().next() == Some(j);
+            if first && tables.shape_edges[k as usize] > 0 {
+                n_own += 1;
+                single = Some(k);
+            }
+        }
+        match (n_all, n_own) {
+            (0, 0) => Strata::None,
+            (_, 0) => Strata::One(Stratum::All),
+            // The moving meshes' tree when it is this mesh's.
+            (0, 1) => match single {
+                Some(k)
+                    if tables.moving_drawn.edges().len()
+                        == tables.shape_drawn[k as usize].edges().len() =>
+                {
+                    Strata::One(Stratum::Moving)
+                }
+                Some(k) => Strata::One(Stratum::Shape(k)),
+                None => Strata::None,
+            },
+            _ => Strata::Mixed { n_all },
+        }
+    }
+
+    /// The boundary points at `x` under [`Space::edge_strata`]'s split
+    /// (`Strata::Mixed`), passed to `f`: every stratum's points taken
+    /// every time (near-certain terms such as a shadow's edge on the lamp
+    /// are not left to a draw), and the one drawn point (`u_draw`) from the
+    /// stratum drawn with `u_pick`, its density times that stratum's
+    /// probability. The rest stratum is every edge but the own meshes'.
+    #[inline]
+    pub(super) fn split_points(
+        &self,
+        x: DVec3,
+        view: &BoundaryView,
+        n_all: usize,
+        [u_draw, u_set, u_pick]: [f64; 3],
+        mut f: impl FnMut(BoundaryPoint<DVec3>),
+    ) {
+        let (chosen, share) = self.pick_stratum(view, n_all, u_pick);
+        let own = |k: u32| !view.own.and(self.shape_params[k as usize]).is_empty();
+        let mut take = |stratum: Stratum| {
+            let draw = (stratum == chosen).then_some((u_draw, share));
+            let keep = |k: u32| stratum != Stratum::All || !own(k);
+            self.edge_points(x, stratum, draw, u_set, keep, &mut f);
+        };
+        if n_all > 0 {
+            take(Stratum::All);
+        }
+        for (k, _) in self.mesh_strata(view, n_all) {
+            take(Stratum::Shape(k));
+        }
+    }
+
+    /// The stratum of [`Space::edge_strata`]'s split whose point is drawn,
+    /// drawn with `u`, and its probability: each mesh's in proportion to
+    /// the slots it serves (its own parameters and every slot that sees
+    /// all), the rest's to the slots that see all.
+    #[inline]
+    fn pick_stratum(&self, view: &BoundaryView, n_all: usize, u: f64) -> (Stratum, f64) {
+        let total = self.mesh_strata(view, n_all).map(|(_, w)| w).sum::<f64>() + n_all as f64;
+        let mut s = u * total;
+        let mut last = (Stratum::All, n_all as f64 / total);
+        for (k, w) in self.mesh_strata(view, n_all) {
+            last = (Stratum::Shape(k), w / total);
+            if s < w {
+                return last;
+            }
+            s -= w;
+        }
+        if n_all > 0 {
+            (Stratum::All, n_all as f64 / total)
+        } else {
+            last
+        }
+    }
+
+    /// The meshes' strata of [`Space::edge_strata`]'s split, each once (at
+    /// its first own parameter), with the number of slots it serves.
+    #[inline]
+    fn mesh_strata<'a>(
+        &'a self,
+        view: &'a BoundaryView,
+        n_all: usize,
+    ) -> impl Iterator<Item = (u32, f64)> + 'a {
+        let tables = self.edge_tables();
+        view.own.iter().filter_map(move |j| {
+            let k = self.scene.parameter_shape(j);
+            let params = view.own.and(self.shape_params[k as usize]);
+            (params.iter().next() == Some(j) && tables.shape_edges[k as usize] > 0)
+                .then(|| (k, (params.len() + n_all) as f64))
+        })
+    }
+
+    // ANCHOR_END: edge_strata
     /// The tree the point is drawn from at `x` (all edges but the lamp
     /// set's if `all`, else the moving ones), whether the lamp parts of
     /// its silhouettes are taken apart (it holds at most [`LAMP_EDGES`]
@@ -481,12 +640,15 @@ impl Space {
     /// so the edges' [`Space::lamp_overlaps`].
     #[inline]
     #[allow(clippy::type_complexity)]
-    fn drawn_tree(&self, x: DVec3, all: bool) -> (&EdgeTree, bool, [f64; LAMP_EDGES], f64) {
+    fn drawn_tree(&self, x: DVec3, stratum: Stratum) -> (&EdgeTree, bool, [f64; LAMP_EDGES], f64) {
         let tables = self.edge_tables();
-        let tree = if all {
-            &tables.all_drawn
-        } else {
-            &tables.moving_drawn
+        let (tree, cache) = match stratum {
+            Stratum::All => (&tables.all_drawn, &self.sensor_lamps[1]),
+            Stratum::Moving => (&tables.moving_drawn, &self.sensor_lamps[0]),
+            Stratum::Shape(k) => (
+                &tables.shape_drawn[k as usize],
+                &self.sensor_shape_lamps[k as usize],
+            ),
         };
         let apart = tree.edges().len() <= LAMP_EDGES
             && !self.emitters.is_empty()
@@ -496,7 +658,7 @@ impl Space {
         let (overlap, total) = if !apart {
             ([0.0; LAMP_EDGES], 0.0)
         } else if x == self.scene.sensor().point() {
-            *self.sensor_lamps[all as usize].get_or_init(|| self.lamp_overlaps(x, tree))
+            *cache.get_or_init(|| self.lamp_overlaps(x, tree))
         } else {
             self.lamp_overlaps(x, tree)
         };
@@ -566,21 +728,28 @@ impl Space {
 
     /// Calls `f` with one point on each lamp edge (of the lamp set,
     /// [`EdgeTables::lamp_set`](super::space::EdgeTables)) that can be a
-    /// discontinuity seen from `x` (all of them if `all`, else the moving
-    /// lamps'), every point at the same fraction `u` of its edge's arc in
+    /// discontinuity seen from `x` (all of them for `Stratum::All`, else
+    /// the moving lamps', for `Stratum::Shape(k)` mesh `k`'s; only of the
+    /// meshes `keep` holds), every point at the same fraction `u` of its
+    /// edge's arc in
     /// angle: density `1/arc` per unit arc length, each edge taken with
     /// probability 1. [`Space::edge_point`] draws among the other edges.
     #[inline]
     fn lamp_edge_points(
         &self,
         x: DVec3,
-        all: bool,
+        stratum: Stratum,
         u: f64,
+        keep: impl Fn(u32) -> bool,
         mut f: impl FnMut(BoundaryPoint<DVec3>),
     ) {
         let tables = self.edge_tables();
-        for &e in &tables.lamp_set[all as usize] {
+        let set = &tables.lamp_set[(stratum == Stratum::All) as usize];
+        for &e in set {
             let edge = &tables.edges[e as usize];
+            if matches!(stratum, Stratum::Shape(k) if edge.shape != k) || !keep(edge.shape) {
+                continue;
+            }
             if !is_discontinuity(edge, &tables.edge_facts[e as usize], x) {
                 continue;
             }
@@ -615,10 +784,12 @@ const CAMERA_JUMP_PATHS: u32 = 2;
 impl Boundaries for Space {
     // ANCHOR: sample_boundary
     /// At a camera pixel, a point on the moving edges seen through it;
-    /// elsewhere the point drawn among the edges seen from the vertex,
-    /// without the ones [`Boundaries::boundary_points`] takes every time
-    /// (`Space::edge_points`); `inv_pdf` is per unit arc length on the
-    /// sphere of directions.
+    /// elsewhere the point drawn among the edges seen from the vertex (all
+    /// of them if some slot of `view` sees all move, else the moving
+    /// meshes'), without the ones [`Boundaries::boundary_points`] takes
+    /// every time (`Space::edge_points`); `inv_pdf` is per unit arc length
+    /// on the sphere of directions. ([`Boundaries::boundary_points`]
+    /// splits the edges among the slots: `Space::edge_strata`.)
     #[inline]
     fn sample_boundary(
         &self,
@@ -633,7 +804,8 @@ impl Boundaries for Space {
             debug_assert!(!all, "a camera does not move");
             return self.pixel_boundary(v.x, pixel, &rect, u);
         }
-        let (tree, apart, overlap, _) = self.drawn_tree(v.x, all);
+        let stratum = if all { Stratum::All } else { Stratum::Moving };
+        let (tree, apart, overlap, _) = self.drawn_tree(v.x, stratum);
         self.drawn_point(v.x, tree, apart.then_some(&overlap), u)
     }
     // ANCHOR_END: sample_boundary
@@ -667,7 +839,21 @@ impl Boundaries for Space {
             return;
         }
         let (u_draw, u_set): (f64, f64) = (rng.random(), rng.random());
-        self.edge_points(v.x, all, u_draw, u_set, |b| f(rng, b));
+        match self.edge_strata(view) {
+            Strata::None => {}
+            Strata::One(stratum) => self.edge_points(
+                v.x,
+                stratum,
+                Some((u_draw, 1.0)),
+                u_set,
+                |_| true,
+                |b| f(rng, b),
+            ),
+            Strata::Mixed { n_all } => {
+                let u_pick: f64 = rng.random();
+                self.split_points(v.x, view, n_all, [u_draw, u_set, u_pick], |b| f(rng, b));
+            }
+        }
     }
 
     /// `CAMERA_JUMP_PATHS` at a camera pixel, else 1.

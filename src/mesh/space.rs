@@ -12,6 +12,7 @@ use super::lobe::SpaceLobe;
 use super::scene::{Scene, Sensor as SceneSensor};
 use super::sensor_view::SensorView;
 use super::warp::{MAX_FIELDS, PoleRule};
+use crate::path::deform::SlotSet;
 use crate::path::{Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec3;
@@ -68,6 +69,10 @@ pub struct Space {
     /// of all edges seen from the sensor's point, where every path starts
     /// (built on first use).
     pub(super) sensor_lamps: [OnceLock<([f64; LAMP_EDGES], f64)>; 2],
+    /// The same per mesh, for its stratum (`Space::edge_strata`).
+    pub(super) sensor_shape_lamps: Vec<OnceLock<([f64; LAMP_EDGES], f64)>>,
+    /// Per mesh, the parameters that move it.
+    pub(super) shape_params: Vec<SlotSet>,
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
     pub(super) pole_rules: Vec<PoleRule>,
@@ -117,6 +122,12 @@ pub(super) struct EdgeTables {
     /// and over those of moving meshes, without the lamp set's.
     pub(super) all_drawn: EdgeTree,
     pub(super) moving_drawn: EdgeTree,
+    /// Per mesh, the hierarchy of its edges without the lamp set's (empty
+    /// for a mesh no parameter moves): a parameter's stratum of the
+    /// boundary term (`Space::edge_strata`).
+    pub(super) shape_drawn: Vec<EdgeTree>,
+    /// Per mesh, its number of edges.
+    pub(super) shape_edges: Vec<u32>,
 }
 
 /// Most lamp edges that every boundary term takes each of, rather than
@@ -196,6 +207,10 @@ impl Space {
                 }
             }
         }
+        let mut shape_params = vec![SlotSet::EMPTY; scene.shapes().len()];
+        for j in 0..scene.parameters().len() {
+            shape_params[scene.parameter_shape(j) as usize].insert(j);
+        }
         Space {
             caster: TriangleBvh::new(tris.clone()),
             opaque: TriangleBvh::new(opaque_tris),
@@ -211,6 +226,8 @@ impl Space {
             pixel_edges: OnceLock::new(),
             sensor_view: OnceLock::new(),
             sensor_lamps: [OnceLock::new(), OnceLock::new()],
+            sensor_shape_lamps: (0..shape_params.len()).map(|_| OnceLock::new()).collect(),
+            shape_params,
             pole_rules,
             slot_field,
             field_bounds,
@@ -385,8 +402,25 @@ impl EdgeTables {
         };
         let all_drawn = EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&all_ids));
         let moving_drawn = EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&moving_ids));
+        let shapes = scene.shapes().len();
+        let shape_drawn = (0..shapes as u32)
+            .map(|k| {
+                let ids: Vec<u32> = moving_ids
+                    .iter()
+                    .copied()
+                    .filter(|&i| edges[i as usize].shape == k)
+                    .collect();
+                EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&ids))
+            })
+            .collect();
+        let mut shape_edges = vec![0u32; shapes];
+        for e in &edges {
+            shape_edges[e.shape as usize] += 1;
+        }
         let all_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, all_ids);
         EdgeTables {
+            shape_drawn,
+            shape_edges,
             edges,
             edge_weight,
             edge_facts,
