@@ -69,25 +69,26 @@ impl Boundaries for Plane {
         }
         let total = self.all_cdf.last().copied().unwrap_or(0.0);
         // The mixture's components: every slot that sees all corners move
-        // draws among all (if any weighs), every parameter whose shape has
-        // corners that weigh among those; the shape of each parameter's
-        // component, and whether they are all one.
+        // draws among all (if any weighs), every parameter among its
+        // shape's (if they weigh: `weighed_shapes`); per shape, the count
+        // of its parameters in `view.own`.
         let n_all = if total > 0.0 { view.all.len() } else { 0 };
-        let own_shape = |j: usize| {
-            let k = self.scene.parameter_shape(j);
-            (self.shape_weight(k) > 0.0).then_some(k)
-        };
-        let mut n_own = 0usize;
-        let mut single = None;
-        let mut mixed = false;
-        for k in view.own.iter().filter_map(own_shape) {
-            n_own += 1;
-            match single {
-                None => single = Some(k),
-                Some(s) => mixed |= s != k,
+        let own_in = |k: u32| view.own.and(self.shape_params[k as usize]).len();
+        // Every parameter and no other slot (a vertex that stays put, the
+        // commonest view): the components are the scene's, counted once.
+        let (n_own, shapes, single) = if n_all == 0 && view.own == self.all_params.0 {
+            self.all_params.1
+        } else {
+            let mut count = (0usize, 0usize, None);
+            for &k in &self.weighed_shapes {
+                let c = own_in(k);
+                if c > 0 {
+                    count = (count.0 + c, count.1 + 1, Some(k));
+                }
             }
-        }
-        mixed |= n_all > 0 && n_own > 0;
+            count
+        };
+        let mixed = shapes > 1 || (n_all > 0 && n_own > 0);
         let n = n_all + n_own;
         if n == 0 {
             return None;
@@ -102,7 +103,17 @@ impl Boundaries for Plane {
             if i < n_all {
                 (None, u)
             } else {
-                (view.own.iter().filter_map(own_shape).nth(i - n_all), u)
+                let mut rest = i - n_all;
+                let mut pick = single;
+                for &k in &self.weighed_shapes {
+                    let c = own_in(k);
+                    if rest < c {
+                        pick = Some(k);
+                        break;
+                    }
+                    rest -= c;
+                }
+                (pick, u)
             }
         };
         let (cdf, first) = match component {
@@ -124,11 +135,7 @@ impl Boundaries for Plane {
             w_total / w
         } else {
             // Every component that holds the corner.
-            let n_shape = view
-                .own
-                .iter()
-                .filter(|&j| own_shape(j) == Some(shape))
-                .count();
+            let n_shape = own_in(shape);
             let p_all = if n_all > 0 { n_all as f64 / total } else { 0.0 };
             let p_shape = n_shape as f64 / self.shape_weight(shape);
             n as f64 / (w * (p_all + p_shape))

@@ -7,6 +7,7 @@
 use super::geometry::{NO_SEGMENT, cross};
 use super::lobe::FlatLobe;
 use super::scene::{Phase, Scene, Sensor as FlatSensor};
+use crate::path::deform::SlotSet;
 use crate::path::{Geometry, Hit, MediumId, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec2;
@@ -34,6 +35,13 @@ pub struct Plane {
     pub(super) shape_cdf: Vec<f64>,
     /// Per shape, its corners `start..end` (empty for a transparent one).
     pub(super) shape_corners: Vec<(u32, u32)>,
+    /// Per shape, the parameters that move it.
+    pub(super) shape_params: Vec<SlotSet>,
+    /// The shapes some parameter moves whose corners weigh (> 0).
+    pub(super) weighed_shapes: Vec<u32>,
+    /// Every parameter's slot, and for that view the parameters with a
+    /// component, the shapes among them and the last such shape.
+    pub(super) all_params: (SlotSet, (usize, usize, Option<u32>)),
     /// The corners visible from an irradiance sensor in front of it, by
     /// angle from +x: the warp's knots there, the same for every path
     /// (found on first use: only the expectation method asks).
@@ -142,6 +150,18 @@ impl Plane {
         for &(start, end) in &shape_corners {
             shape_cdf.extend(cdf(&mut (start as usize..end as usize)));
         }
+        let mut shape_params = vec![SlotSet::EMPTY; scene.shapes().len()];
+        for j in 0..params {
+            shape_params[scene.parameter_shape(j) as usize].insert(j);
+        }
+        let weighed_shapes: Vec<u32> = (0..scene.shapes().len() as u32)
+            .filter(|&k| {
+                let (start, end) = shape_corners[k as usize];
+                !shape_params[k as usize].is_empty()
+                    && end > start
+                    && shape_cdf[end as usize - 1] > 0.0
+            })
+            .collect();
         Plane {
             scene,
             corner_segments,
@@ -150,6 +170,14 @@ impl Plane {
             all_cdf,
             shape_cdf,
             shape_corners,
+            all_params: (
+                SlotSet::first(params),
+                weighed_shapes.iter().fold((0, 0, None), |(n, m, _), &k| {
+                    (n + shape_params[k as usize].len(), m + 1, Some(k))
+                }),
+            ),
+            shape_params,
+            weighed_shapes,
             sensor_knots: OnceLock::new(),
             sensor_gaps: OnceLock::new(),
             camera_corners: OnceLock::new(),
