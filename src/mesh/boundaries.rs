@@ -524,25 +524,19 @@ impl Space {
     /// stratum as before (all edges; the moving meshes' when one mesh's
     /// parameters are all that need them). Otherwise the edges are split
     /// into strata, one per mesh moved by a parameter of `view.own`, and
-    /// the rest (every other edge, if some slot sees all move), and one
-    /// stratum is drawn per term ([`Space::pick_stratum`]): a few edges of
+    /// the rest (every other edge, if some slot sees all move): every
+    /// stratum's points taken every time are taken, the one drawn point
+    /// comes from a stratum drawn ([`Space::split_points`]). A few edges of
     /// a small moving mesh then get the draws their parameters need, not
     /// their share of the estimated contribution among thousands.
     #[inline]
     pub(super) fn edge_strata(&self, view: &BoundaryView) -> Strata {
         let tables = self.edge_tables();
         let n_all = view.all.len();
-        // Meshes of own parameters that have edges: count them (each once,
-        // at its first own parameter).
-        let mut n_own = 0;
-        let mut single = None;
-        for j in view.own.iter() {
-            let k = self.scene.parameter_shape(j);
-            let first = view.own.and(self.shape_params[k as usize]).iter().next() == Some(j);
-            if first && tables.shape_edges[k as usize] > 0 {
-                n_own += 1;
-                single = Some(k);
-            }
+        let (mut n_own, mut single) = (0, None);
+        for (k, _) in self.mesh_strata(view, n_all) {
+            n_own += 1;
+            single = Some(k);
         }
         match (n_all, n_own) {
             (0, 0) => Strata::None,
