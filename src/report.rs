@@ -111,6 +111,10 @@ pub struct MeanErr {
     /// estimator said so when it was built.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub caveat: Option<String>,
+    /// Pairs of paths that jumped, for a central difference
+    /// ([`Estimate::jumps`]); absent for the other methods.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub jumps: Option<u64>,
 }
 
 impl MeanErr {
@@ -122,6 +126,7 @@ impl MeanErr {
             nonzero: e.nonzero,
             reliable: e.is_reliable() && caveat.is_none(),
             caveat: caveat.cloned(),
+            jumps: e.jumps,
         }
     }
 }

@@ -86,8 +86,12 @@ impl FromStr for Shard {
 }
 
 /// One block's moments of one quantity, every float as its bits: count,
-/// non-zero count, mean, M2, M3, M4, largest |w|, Σ|w|.
-type Packed = [u64; 8];
+/// non-zero count, mean, M2, M3, M4, largest |w|, Σ|w|, jumps (`u64::MAX`
+/// where not counted).
+type Packed = [u64; 9];
+
+/// [`Moments::jumps`] packed: `u64::MAX` for `None` (a count never gets there).
+const NO_JUMPS: u64 = u64::MAX;
 
 fn pack(m: &Moments) -> Packed {
     [
@@ -99,6 +103,7 @@ fn pack(m: &Moments) -> Packed {
         m.m4.to_bits(),
         m.max_abs.to_bits(),
         m.sum_abs.to_bits(),
+        m.jumps.unwrap_or(NO_JUMPS),
     ]
 }
 
@@ -112,6 +117,7 @@ fn unpack(p: &Packed) -> Moments {
         m4: f64::from_bits(p[5]),
         max_abs: f64::from_bits(p[6]),
         sum_abs: f64::from_bits(p[7]),
+        jumps: (p[8] != NO_JUMPS).then_some(p[8]),
     }
 }
 
@@ -143,31 +149,23 @@ pub enum Payload {
 
 /// One pixel's [`PixelSums`] of one quantity: the packed pooled moments,
 /// the bits of its mean and standard error.
-type PackedPixel = [u64; 10];
+type PackedPixel = [u64; 11];
 
 fn pack_pixel(p: &PixelSums) -> PackedPixel {
-    let m = pack(&p.pooled);
-    [
-        m[0],
-        m[1],
-        m[2],
-        m[3],
-        m[4],
-        m[5],
-        m[6],
-        m[7],
-        p.mean.to_bits(),
-        p.stderr.to_bits(),
-    ]
+    let mut out = [0; 11];
+    out[..9].copy_from_slice(&pack(&p.pooled));
+    out[9] = p.mean.to_bits();
+    out[10] = p.stderr.to_bits();
+    out
 }
 
 fn unpack_pixel(p: &PackedPixel) -> PixelSums {
-    let mut m = [0; 8];
-    m.copy_from_slice(&p[..8]);
+    let mut m = [0; 9];
+    m.copy_from_slice(&p[..9]);
     PixelSums {
         pooled: unpack(&m),
-        mean: f64::from_bits(p[8]),
-        stderr: f64::from_bits(p[9]),
+        mean: f64::from_bits(p[9]),
+        stderr: f64::from_bits(p[10]),
     }
 }
 

@@ -40,9 +40,26 @@ pub struct ChunkSums {
     s4: f64,
     max_abs: f64,
     sum_abs: f64,
+    /// Jumps counted apart ([`ChunkSums::track_jumps`]), if the estimator
+    /// counts them.
+    jumps: Option<u64>,
 }
 
 impl ChunkSums {
+    /// Declares that this quantity's weights rest on rare jumps the
+    /// estimator counts ([`ChunkSums::push_jump`]): the estimate is then
+    /// reliable only with [`Estimate::MIN_NONZERO`] of them or more.
+    #[inline]
+    pub fn track_jumps(&mut self) {
+        self.jumps.get_or_insert(0);
+    }
+
+    /// Counts one jump (a weight, pushed as usual, that came from one).
+    #[inline]
+    pub fn push_jump(&mut self) {
+        *self.jumps.get_or_insert(0) += 1;
+    }
+
     /// Adds one weight.
     #[inline]
     pub fn push(&mut self, w: f64) {
@@ -71,6 +88,7 @@ impl ChunkSums {
         if self.n == 0 {
             return Moments {
                 n: total,
+                jumps: self.jumps,
                 ..Moments::default()
             };
         }
@@ -95,6 +113,7 @@ impl ChunkSums {
             m4: rounding_floor(s4 - 4.0 * m * s3 + 6.0 * m2 * s2 - 3.0 * n * m2 * m2),
             max_abs: self.max_abs,
             sum_abs: self.sum_abs,
+            jumps: self.jumps,
         }
     }
 }
@@ -180,6 +199,9 @@ pub struct Moments {
     pub max_abs: f64,
     /// Σ|w|.
     pub sum_abs: f64,
+    /// Jumps among the weights, where the estimator counts them (see
+    /// [`ChunkSums::track_jumps`]).
+    pub jumps: Option<u64>,
 }
 
 impl Moments {
@@ -192,11 +214,15 @@ impl Moments {
 
     /// The moments of the union of `self` and `other` (Pébay 2008, Eq. 3.1).
     pub fn merge(&self, other: &Moments) -> Moments {
+        let jumps = match (self.jumps, other.jumps) {
+            (None, None) => None,
+            (a, b) => Some(a.unwrap_or(0) + b.unwrap_or(0)),
+        };
         if self.n == 0 {
-            return *other;
+            return Moments { jumps, ..*other };
         }
         if other.n == 0 {
-            return *self;
+            return Moments { jumps, ..*self };
         }
         let (na, nb) = (self.n as f64, other.n as f64);
         let n = na + nb;
@@ -218,6 +244,7 @@ impl Moments {
                 + 4.0 * d * (na * other.m3 - nb * self.m3) / n,
             max_abs: self.max_abs.max(other.max_abs),
             sum_abs: self.sum_abs + other.sum_abs,
+            jumps,
         }
     }
 
@@ -253,6 +280,7 @@ impl Moments {
             n: self.n,
             vov,
             max_share,
+            jumps: self.jumps,
         }
     }
 }
@@ -277,6 +305,11 @@ pub struct Estimate {
     pub vov: f64,
     /// Largest weight's share of `Σ|w|`.
     pub max_share: f64,
+    /// Jumps the estimate rests on, where its estimator counts them: a
+    /// central difference's pairs of paths that one side of the step
+    /// changed discontinuously (one blocked, the other not, say), which
+    /// carry its whole boundary part. `None` where not counted.
+    pub jumps: Option<u64>,
 }
 
 impl Estimate {
@@ -305,12 +338,16 @@ impl Estimate {
             n: 0,
             vov: 0.0,
             max_share: 0.0,
+            jumps: None,
         }
     }
 
     /// Whether the error bar can be trusted. A sampled estimate (`n > 0`) is
     /// reliable when its mean, standard error and VOV are finite, at least
-    /// [`MIN_NONZERO`](Self::MIN_NONZERO) weights were non-zero, and the VOV
+    /// [`MIN_NONZERO`](Self::MIN_NONZERO) weights were non-zero (and as
+    /// many jumps, where they are counted: a weight of tiny probability
+    /// that no path drew leaves the other diagnostics clean, and a
+    /// central difference knows how many of its pairs jumped), and the VOV
     /// is below [`VOV_LIMIT`](Self::VOV_LIMIT). An exact value (`n = 0`) is
     /// reliable when finite. The largest weight's share is reported beside
     /// it for the reader to judge (it is at least 1/N, so no fixed threshold
@@ -320,7 +357,10 @@ impl Estimate {
         if self.n == 0 {
             return finite;
         }
-        finite && self.nonzero >= Self::MIN_NONZERO && self.vov < Self::VOV_LIMIT
+        finite
+            && self.nonzero >= Self::MIN_NONZERO
+            && self.jumps.is_none_or(|k| k >= Self::MIN_NONZERO)
+            && self.vov < Self::VOV_LIMIT
     }
 
     /// Distance from `reference` in standard errors (∞ if the error bar is 0
@@ -333,7 +373,8 @@ impl Estimate {
 
 impl Serialize for Estimate {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let mut s = serializer.serialize_struct("Estimate", 7)?;
+        let fields = 7 + usize::from(self.jumps.is_some());
+        let mut s = serializer.serialize_struct("Estimate", fields)?;
         s.serialize_field("mean", &self.mean)?;
         s.serialize_field("stderr", &self.stderr)?;
         s.serialize_field("nonzero", &self.nonzero)?;
@@ -341,6 +382,11 @@ impl Serialize for Estimate {
         s.serialize_field("n", &self.n)?;
         s.serialize_field("vov", &self.vov)?;
         s.serialize_field("max_share", &self.max_share)?;
+        if let Some(k) = self.jumps {
+            s.serialize_field("jumps", &k)?;
+        } else {
+            s.skip_field("jumps")?;
+        }
         s.end()
     }
 }

@@ -86,8 +86,12 @@ fn json_has_exactly_the_documented_keys_and_nulls() {
             if present {
                 let q = v[key].as_object().unwrap();
                 // mean, stderr, and (issue 11) the count of non-zero
-                // weights and whether the error bar can be trusted.
-                assert_eq!(q.len(), 4, "{method} {key}: {q:?}");
+                // weights and whether the error bar can be trusted; a
+                // central difference's derivative also the pairs of paths
+                // that jumped.
+                let jumps = method == "fd" && *key == "sensitivity";
+                assert_eq!(q.len(), 4 + usize::from(jumps), "{method} {key}: {q:?}");
+                assert_eq!(q.get("jumps").is_some_and(|k| k.is_u64()), jumps);
                 assert!(q["mean"].is_f64() && q["stderr"].is_f64(), "{method} {key}");
                 assert!(
                     q["nonzero"].is_u64() && q["reliable"].is_boolean(),

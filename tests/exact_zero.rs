@@ -120,6 +120,18 @@ fn check(problem_name: &str, result: &geosens::RunResult, zeros: &[&str]) {
     }
 }
 
+/// The slab's scale changes every chord smoothly and no path's fate: a
+/// central difference draws no jump, and cannot tell that from jumps it
+/// never drew (`tests/reliability.rs`), so it says "not reliable" however
+/// right its value; the other methods' error bars are reliable.
+fn smooth_or_reliable(m: Method, s: &geosens::Estimate) -> bool {
+    if m == Method::Fd {
+        s.jumps == Some(0) && !s.is_reliable()
+    } else {
+        s.is_reliable()
+    }
+}
+
 #[test]
 fn an_exactly_zero_derivative_reads_zero_in_flatland() {
     let scene = Arc::new(geosens::flat::file::from_toml(FLAT).unwrap());
@@ -131,7 +143,7 @@ fn an_exactly_zero_derivative_reads_zero_in_flatland() {
         let s = r.get(&Quantity::sensitivity("slab_scale")).unwrap();
         // fd's bias at its default step is far below this run's error bar.
         assert!(
-            s.z_score(reference) < 4.0 && s.is_reliable(),
+            s.z_score(reference) < 4.0 && smooth_or_reliable(m, &s),
             "{m}: ∂E/∂scale = {} ± {} against {reference}",
             s.mean,
             s.stderr
@@ -148,7 +160,7 @@ fn an_exactly_zero_derivative_reads_zero_in_3d() {
         let r = run(m.estimator(Arc::clone(&scene)).unwrap().as_ref(), &cfg).unwrap();
         check("3D", &r, &["slab_tx", "slab_tz"]);
         let s = r.get(&Quantity::sensitivity("slab_scale")).unwrap();
-        assert!(s.is_reliable() && s.mean < 0.0, "{m}: {s:?}");
+        assert!(smooth_or_reliable(m, &s) && s.mean < 0.0, "{m}: {s:?}");
         scale.push(s);
     }
     // The methods agree on the non-zero one (no closed form written here:

@@ -78,3 +78,56 @@ fn nonzero_counts_the_contributing_paths() {
     assert_eq!(json["nonzero"].as_u64(), Some(s.nonzero));
     assert_eq!(json["reliable"].as_bool(), Some(true));
 }
+
+/// The fog of `scenes/fog.toml` made optically thin (κe = 0.05, κs = 0.04):
+/// a collision inside it is rare, and one near its moving edge rarer still.
+fn thin_fog() -> geosens::flat::Scene {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/fog.toml"))
+        .unwrap()
+        .replace("ks = 1.2, ke = 1.5", "ks = 0.04, ke = 0.05");
+    geosens::flat::file::from_toml(&text).unwrap()
+}
+
+#[test]
+fn a_central_difference_that_drew_no_jump_is_not_reliable() {
+    // Central differences with common random numbers: the two displaced
+    // fogs change a path smoothly (its transmittance) unless a collision
+    // falls in the sliver between their edges (probability ∝ the step),
+    // which changes it by O(1): the boundary part of the derivative rests
+    // on those jumps alone. At 2·10⁴ paths none fell there: the smooth part
+    // alone (about twice the derivative) with every weight non-zero and a
+    // small VOV, which looked reliable; the count of jumps flags it.
+    use geosens::flat::Method as Flat;
+    let scene = std::sync::Arc::new(thin_fog());
+    let q = Quantity::sensitivity("fog_scale");
+    let run = |m: Flat, paths: u64| {
+        let e = m.estimator(scene.clone()).unwrap();
+        let cfg = geosens::RunConfig::new(paths, 3).unwrap().threads(2);
+        geosens::run(e.as_ref(), &cfg).unwrap().get(&q).unwrap()
+    };
+    let few = run(Flat::Fd, 20_000);
+    assert!(few.nonzero >= 10 && few.vov < 0.1, "{few:?}");
+    assert_eq!(few.jumps, Some(0), "{few:?}");
+    assert!(!few.is_reliable(), "{few:?}");
+    // The reference: rendering, whose boundary term is sampled, not waited for.
+    let reference = run(Flat::Rendering, 400_000);
+    assert!(reference.is_reliable(), "{reference:?}");
+    assert!(
+        few.z_score(reference.mean) > 20.0,
+        "the flagged estimate was far off ({few:?} against {reference:?}): \
+         otherwise this test shows nothing"
+    );
+    // Enough paths to draw the jumps: flagged reliable, and right.
+    let many = run(Flat::Fd, 2_000_000);
+    assert!(many.jumps.unwrap() >= 100 && many.is_reliable(), "{many:?}");
+    let z = (many.mean - reference.mean) / many.stderr.hypot(reference.stderr);
+    assert!(z.abs() < 4.0, "z = {z}: {many:?} against {reference:?}");
+    // Other methods count no jumps; their JSON has no such key.
+    assert_eq!(reference.jumps, None);
+    let json = serde_json::to_value(reference).unwrap();
+    assert!(json.get("jumps").is_none());
+    assert_eq!(
+        serde_json::to_value(many).unwrap()["jumps"],
+        many.jumps.unwrap()
+    );
+}

@@ -151,7 +151,8 @@ def rod(
     Returns:
         ``{"method", "intensity", "sensitivity", "gradient_x", "paths",
         "seconds"}``, each quantity ``{"mean", "stderr", "nonzero",
-        "reliable"}`` or None if the method does not estimate it; or, with
+        "reliable"}`` (``fd``'s derivative also ``"jumps"``) or None if the
+        method does not estimate it; or, with
         ``shard``, the shard's state.
 
     Raises:

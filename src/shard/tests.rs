@@ -43,9 +43,13 @@ fn packing_keeps_every_bit() {
         m4: f64::MIN_POSITIVE / 2.0,
         max_abs: -0.0,
         sum_abs: 1e300,
+        jumps: Some(0),
     };
     let back = unpack(&pack(&m));
     assert_eq!(pack(&back), pack(&m));
+    assert_eq!(back.jumps, Some(0));
+    let untracked = Moments { jumps: None, ..m };
+    assert_eq!(unpack(&pack(&untracked)).jumps, None);
     assert!(back.m2.is_nan() && back.m3 == f64::INFINITY);
     assert!(back.max_abs.is_sign_negative());
 }

@@ -150,6 +150,7 @@ pub fn finite_difference(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
             n: a.n,
             vov: a.vov.max(b.vov),
             max_share: a.max_share.max(b.max_share),
+            jumps: None,
         };
         points.push(point("independent", h, independent, exact));
         // Common random numbers: one run of the per-path difference.
