@@ -94,3 +94,38 @@ fn every_method_degrades_as_the_sensor_nears_a_moving_boundary() {
         "finite differences: {fd:?} vs {exact_near}"
     );
 }
+
+#[test]
+fn corners_on_one_sight_line_are_a_caveat_for_every_method() {
+    // At gap 0 the occluder's corner crosses the lamp end's sight line at
+    // the nominal parameter: E has a kink there (the closed form's
+    // one-sided derivatives differ), and each method returns one side or
+    // neither with an error bar that cannot tell. Every derivative method
+    // says so; a gap of 1e-6 (the test above: every method on the closed
+    // form) is no tie.
+    let left = Reference::for_scene(&aligned_corners(-1e-9))
+        .unwrap()
+        .derivative(0);
+    let right = Reference::for_scene(&aligned_corners(1e-9))
+        .unwrap()
+        .derivative(0);
+    assert!(
+        (left - right).abs() > 0.1 * right.abs(),
+        "no kink: {left} vs {right}"
+    );
+    let caveat = |gap: f64, m: Method| {
+        let e = m.estimator(aligned_corners(gap)).unwrap();
+        e.caveats()
+            .into_iter()
+            .find(|(q, _)| *q == Quantity::sensitivity("p"))
+            .map(|(_, why)| why)
+    };
+    for m in [Method::Rendering, Method::Expectation, Method::Transport] {
+        let why = caveat(0.0, m).unwrap_or_else(|| panic!("{m}: no caveat at the tie"));
+        assert!(
+            why.contains("one sight line") && why.contains("kink"),
+            "{m}: {why}"
+        );
+        assert_eq!(caveat(1e-6, m), None, "{m} at gap 1e-6");
+    }
+}

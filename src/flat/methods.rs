@@ -112,6 +112,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
             let k = scene.parameter_shape(j) as usize;
             matches!(scene.shapes()[k].surface, super::Surface::Reflector { .. })
         });
+    let caveats = ties(&scene);
     let geometry = Plane::new(scene);
     let slots = Slots::new(&geometry, geometry.scene().shapes().len(), gradient, twins);
     DerivativeEstimator {
@@ -119,8 +120,75 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
         slots,
         scheme,
         names,
-        caveats: Vec::new(),
+        caveats,
     }
+}
+
+/// Largest angle (rad) between two corners' sight lines from the sensor
+/// that [`ties`] takes for an alignment: the rounding of an exact one.
+pub const TIE: f64 = 1e-12;
+
+/// Where `I` may not be differentiable: two corners in front of an
+/// irradiance sensor (or a camera) lie on one sight line, within [`TIE`],
+/// the nearer visible and one of them on a moved shape (an occluder's end
+/// exactly on a lamp end's sight line; a segment seen edge-on, its two
+/// ends aligned). A corner of the moved shape then crosses the other's
+/// sight line at the nominal parameter, and the one-sided derivatives
+/// differ: each method returns one of them or neither, with an error bar
+/// that cannot tell (found by a random-scene campaign: rendering 1.009,
+/// expectation 0, the two sides of the tie). One caveat per parameter of
+/// such a shape. The 3D twin is [`crate::mesh::methods::kinks`].
+pub fn ties(scene: &Scene) -> Vec<(Quantity, String)> {
+    let (point, normal) = match scene.sensor() {
+        super::Sensor::Irradiance { point, normal } => (point, normal),
+        super::Sensor::Camera {
+            position,
+            direction,
+            ..
+        } => (position, direction),
+        super::Sensor::Radiance { .. } => return Vec::new(),
+    };
+    let corners = scene.corners();
+    let mut ahead: Vec<(f64, f64, usize)> = corners
+        .iter()
+        .enumerate()
+        .filter(|(_, (q, _))| (*q - point).dot(normal) > 0.0)
+        .map(|(i, (q, _))| {
+            let r = *q - point;
+            (r.y.atan2(r.x), r.length(), i)
+        })
+        .collect();
+    ahead.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut tied: Vec<(u32, u32)> = Vec::new();
+    for (i, a) in ahead.iter().enumerate() {
+        for b in ahead[i + 1..].iter().take_while(|b| b.0 - a.0 <= TIE) {
+            let near = if a.1 <= b.1 { a.2 } else { b.2 };
+            let (ka, kb) = (corners[a.2].1, corners[b.2].1);
+            if scene.visible(point, corners[near].0, super::geometry::NO_SEGMENT) {
+                tied.push((ka, kb));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (j, p) in scene.parameters().iter().enumerate() {
+        let k = scene.parameter_shape(j);
+        if let Some(&(ka, kb)) = tied.iter().find(|&&(a, b)| a == k || b == k) {
+            let names = (
+                &scene.shapes()[ka as usize].name,
+                &scene.shapes()[kb as usize].name,
+            );
+            out.push((
+                Quantity::sensitivity(&p.name),
+                format!(
+                    "corners of {:?} and {:?} lie on one sight line from the sensor: I may have \
+                     a kink along {:?} (the one-sided derivatives differ) and the estimate is \
+                     one of them or neither",
+                    names.0, names.1, p.name
+                ),
+            ));
+        }
+    }
+    out
 }
 
 /// Central differences with common random numbers: `I` on the nominal
