@@ -161,6 +161,22 @@ pub fn stratified(
     w: &mut [f64],
     mut sample: impl FnMut(PixelSample, &mut [f64]),
 ) {
+    stratified_marked(pixel, spp, sums, w, &mut [], |s, w, _| sample(s, w));
+}
+
+/// [`stratified`], `sample` also setting `jumped[k]` when quantity `k`'s
+/// weight came from a jump (a central difference's: see
+/// [`StratumSums::push_jump`]); `jumped` may be shorter than `sums` (empty:
+/// no jumps counted).
+#[inline]
+pub fn stratified_marked(
+    pixel: u32,
+    spp: u64,
+    sums: &mut [StratumSums],
+    w: &mut [f64],
+    jumped: &mut [bool],
+    mut sample: impl FnMut(PixelSample, &mut [f64], &mut [bool]),
+) {
     let m = strata_per_side(spp);
     let cells = m * m;
     let (base, extra) = (spp / cells, spp % cells);
@@ -171,9 +187,15 @@ pub fn stratified(
             strata: m as u32,
         };
         for _ in 0..base + u64::from(stratum < extra) {
-            sample(s, w);
+            sample(s, w, jumped);
             for (s, &x) in sums.iter_mut().zip(w.iter()) {
                 s.push(x);
+            }
+            for (s, j) in sums.iter_mut().zip(jumped.iter_mut()) {
+                if *j {
+                    s.push_jump();
+                    *j = false;
+                }
             }
         }
         for s in sums.iter_mut() {

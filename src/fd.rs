@@ -12,7 +12,7 @@ use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
 use crate::path::PixelSample;
 use crate::rng::PathRng;
-use crate::stats::ChunkSums;
+use crate::stats::{ChunkSums, StratumSums};
 
 /// Default half step of [`Method::Fd`](crate::Method::Fd): relative to the
 /// scene's size for a translation (the rod's length, flatland's bounding box),
@@ -186,6 +186,20 @@ impl Estimator for CentralDifference {
 
     fn sample_pixel(&self, rng: &mut PathRng, pixel: PixelSample, weights: &mut [f64]) {
         self.differences(rng, pixel, weights, |_| ());
+    }
+
+    /// The provided pixel loop, counting jumps as [`Self::accumulate`]
+    /// does, per pixel (and so over the image, for its mean).
+    fn accumulate_pixel(&self, rng: &mut PathRng, pixel: u32, spp: u64, sums: &mut [StratumSums]) {
+        let first = usize::from(self.nominal.is_some());
+        let mut w = vec![0.0; sums.len()];
+        let mut jumped = vec![false; if first == 1 { sums.len() } else { 0 }];
+        if first == 1 {
+            sums[1..].iter_mut().for_each(StratumSums::track_jumps);
+        }
+        crate::estimator::stratified_marked(pixel, spp, sums, &mut w, &mut jumped, |s, w, j| {
+            self.differences(rng, s, w, |k| j[first + k] = true)
+        });
     }
 
     /// The provided loop, besides counting per parameter, where `I` is

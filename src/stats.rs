@@ -135,9 +135,22 @@ pub struct StratumSums {
     means: f64,
     variances: f64,
     strata: u32,
+    jumps: bool,
 }
 
 impl StratumSums {
+    /// Counts jumps in every stratum ([`ChunkSums::track_jumps`]).
+    pub fn track_jumps(&mut self) {
+        self.jumps = true;
+        self.stratum.track_jumps();
+    }
+
+    /// Counts one jump in the current stratum ([`ChunkSums::push_jump`]).
+    #[inline]
+    pub fn push_jump(&mut self) {
+        self.stratum.push_jump();
+    }
+
     /// Adds one weight to the current stratum.
     #[inline]
     pub fn push(&mut self, w: f64) {
@@ -154,6 +167,9 @@ impl StratumSums {
         self.pooled = self.pooled.merge(&m);
         self.strata += 1;
         self.stratum = ChunkSums::default();
+        if self.jumps {
+            self.stratum.track_jumps();
+        }
     }
 
     /// The moments of every weight of the closed strata, pooled.
