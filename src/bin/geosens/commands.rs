@@ -204,8 +204,10 @@ pub(super) fn compare_command(
     writeln!(
         out,
         "\nper method over the 16 probes (z: distance to exact in stderrs; \
-         !: error bar unreliable: VOV ≥ {}, fewer than {} non-zero weights, or not finite)",
+         !: error bar unreliable: VOV ≥ {}, fewer than {} non-zero weights (for fd, also \
+         fewer than {} jumps), or not finite)",
         Estimate::VOV_LIMIT,
+        Estimate::MIN_NONZERO,
         Estimate::MIN_NONZERO
     )?;
     writeln!(
