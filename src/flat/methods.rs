@@ -139,26 +139,10 @@ pub const TIE: f64 = 1e-12;
 /// expectation 0, the two sides of the tie). One caveat per parameter of
 /// such a shape. The 3D twin is [`crate::mesh::methods::kinks`].
 pub fn ties(scene: &Scene) -> Vec<(Quantity, String)> {
-    let (point, normal) = match scene.sensor() {
-        super::Sensor::Irradiance { point, normal } => (point, normal),
-        super::Sensor::Camera {
-            position,
-            direction,
-            ..
-        } => (position, direction),
-        super::Sensor::Radiance { .. } => return Vec::new(),
+    let Some((point, ahead)) = super::space::corners_ahead(scene) else {
+        return Vec::new();
     };
     let corners = scene.corners();
-    let mut ahead: Vec<(f64, f64, usize)> = corners
-        .iter()
-        .enumerate()
-        .filter(|(_, (q, _))| (*q - point).dot(normal) > 0.0)
-        .map(|(i, (q, _))| {
-            let r = *q - point;
-            (r.y.atan2(r.x), r.length(), i)
-        })
-        .collect();
-    ahead.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut tied: Vec<(u32, u32)> = Vec::new();
     for (i, a) in ahead.iter().enumerate() {
         for b in ahead[i + 1..].iter().take_while(|b| b.0 - a.0 <= TIE) {

@@ -265,6 +265,25 @@ impl Plane {
 /// angle from +x: `(angle, index into scene.corners())`; none for a
 /// radiance sensor.
 pub(super) fn sensor_corners(scene: &Scene) -> Vec<(f64, usize)> {
+    let Some((point, ahead)) = corners_ahead(scene) else {
+        return Vec::new();
+    };
+    let corners = scene.corners();
+    ahead
+        .into_iter()
+        .filter(|&(_, _, i)| scene.visible(point, corners[i].0, NO_SEGMENT))
+        .map(|(angle, _, i)| (angle, i))
+        .collect()
+}
+
+/// A corner in front of the sensor: `(angle from +x, distance, index into
+/// scene.corners())`.
+pub(super) type CornerAhead = (f64, f64, usize);
+
+/// The sensor's point (a camera's position) and every corner in front of
+/// it, hidden or not, by angle ([`CornerAhead`]); `None` for a radiance
+/// sensor.
+pub(super) fn corners_ahead(scene: &Scene) -> Option<(DVec2, Vec<CornerAhead>)> {
     let (point, normal) = match scene.sensor() {
         FlatSensor::Irradiance { point, normal } => (point, normal),
         FlatSensor::Camera {
@@ -272,21 +291,20 @@ pub(super) fn sensor_corners(scene: &Scene) -> Vec<(f64, usize)> {
             direction,
             ..
         } => (position, direction),
-        FlatSensor::Radiance { .. } => return Vec::new(),
+        FlatSensor::Radiance { .. } => return None,
     };
-    let mut seen: Vec<(f64, usize)> = scene
+    let mut ahead: Vec<CornerAhead> = scene
         .corners()
         .iter()
         .enumerate()
         .filter(|(_, (q, _))| (*q - point).dot(normal) > 0.0)
-        .filter(|(_, (q, _))| scene.visible(point, *q, NO_SEGMENT))
         .map(|(i, (q, _))| {
             let r = *q - point;
-            (r.y.atan2(r.x), i)
+            (r.y.atan2(r.x), r.length(), i)
         })
         .collect();
-    seen.sort_by(|a, b| a.0.total_cmp(&b.0));
-    seen
+    ahead.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Some((point, ahead))
 }
 
 impl Geometry for Plane {

@@ -249,7 +249,7 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
         .filter(|&i| is_discontinuity(&t.edges[i], &t.edge_facts[i], x))
         .collect();
     let params = scene.parameters();
-    let moved = |k: u32| (0..params.len()).any(|j| scene.parameter_shape(j) == k);
+    let moved = |k: u32| !space.shape_params[k as usize].is_empty();
     let mut tied: Vec<(u32, u32)> = Vec::new();
     for &i in seen.iter().filter(|&&i| moved(t.edges[i].shape)) {
         let a = &t.edges[i];
