@@ -365,6 +365,11 @@ impl Geometry for Plane {
         self.scene.normal(p)
     }
     #[inline]
+    fn solid(&self, p: Prim) -> bool {
+        let s = self.scene.shape_of(p);
+        s.closed && s.surface != Surface::Transparent
+    }
+    #[inline]
     fn coefficients(&self, m: MediumId) -> Option<(f64, f64)> {
         self.scene.medium(m).map(|m| (m.ks, m.ke))
     }

@@ -493,6 +493,10 @@ impl Geometry for Space {
         self.normals[p as usize]
     }
     #[inline]
+    fn solid(&self, p: Prim) -> bool {
+        self.scene.is_solid(self.owner[p as usize])
+    }
+    #[inline]
     fn coefficients(&self, m: MediumId) -> Option<(f64, f64)> {
         self.scene.medium(m).map(|m| (m.ks, m.ke))
     }

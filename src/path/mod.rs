@@ -269,6 +269,16 @@ pub trait Geometry: Sync {
     /// Unit normal of primitive `p` at its point `y` (outward for closed
     /// shapes).
     fn normal(&self, p: Prim, y: Self::V) -> Self::V;
+    /// Whether primitive `p` bounds a solid no path reaches the inside of:
+    /// flatland's closed opaque polygons, 3D's closed opaque meshes the
+    /// sensor is outside (around the sensor, one is a room). A ray that meets such a primitive from
+    /// behind (along its outward normal) got there by rounding, along a
+    /// sight line through a corner; the walk takes the back as black (see
+    /// [`walk::walk`]).
+    #[inline]
+    fn solid(&self, _p: Prim) -> bool {
+        false
+    }
     /// `(κs, κe)` of a medium.
     fn coefficients(&self, m: MediumId) -> Option<(f64, f64)>;
     /// The medium entered or left when a ray in `m` crosses the transparent

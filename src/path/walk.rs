@@ -381,6 +381,16 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                 hooks.interface(g, rng, &leg, x, next);
                 medium = next;
             }
+            // The back of a solid: a sight line through a corner (the
+            // sensor in the plane of a face, say) that rounding carried
+            // inside. The radiance there is irrelevant (nothing outside sees
+            // it); left lit, a closed reflector of albedo 1 kept the path for
+            // the roulette's 10⁵ events (rendering took 10⁴ times the
+            // intensity estimator's time).
+            Surface::Reflector { .. } if g.solid(h.prim) && w.dot(g.normal(h.prim, x)) > 0.0 => {
+                hooks.opaque(g, rng, &leg, x, k, drawn);
+                return total;
+            }
             Surface::Reflector { albedo } => {
                 let lobe = reflector_lobe(g, h.prim, x, w, albedo);
                 beta *= lobe.weight();
@@ -426,6 +436,8 @@ pub fn surface_radiance<G: Geometry>(
     match g.surface(p) {
         Surface::Emitter { radiance } => radiance,
         Surface::Absorber | Surface::Transparent => 0.0,
+        // The back of a solid, as in `walk`.
+        Surface::Reflector { .. } if g.solid(p) && w.dot(g.normal(p, y)) > 0.0 => 0.0,
         Surface::Reflector { albedo } => {
             let lobe = reflector_lobe(g, p, y, w, albedo);
             let v = Vertex {

@@ -236,6 +236,9 @@ pub struct Scene {
     /// Per shape, whether its mesh is closed (every edge shared by exactly
     /// two triangles with opposite orientations).
     closed: Vec<bool>,
+    /// Per shape, whether it is a solid: closed, opaque, and the sensor
+    /// outside it, so no path reaches its inside.
+    solid: Vec<bool>,
     /// For each shape, the medium shape around it (innermost enclosing
     /// closed mesh with a medium), if any.
     parent: Vec<Option<u32>>,
@@ -281,6 +284,13 @@ impl Scene {
     /// Whether shape `k`'s mesh is closed.
     pub fn is_closed(&self, k: u32) -> bool {
         self.closed[k as usize]
+    }
+    /// Whether shape `k` is a solid: a closed opaque mesh the sensor is
+    /// outside, whose inside no path reaches (a closed opaque mesh around
+    /// the sensor is a room instead).
+    #[inline]
+    pub fn is_solid(&self, k: u32) -> bool {
+        self.solid[k as usize]
     }
     /// Largest extent of the scene's bounding box.
     pub fn size(&self) -> f64 {

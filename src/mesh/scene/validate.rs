@@ -133,12 +133,18 @@ impl Scene {
         let sensor = check_sensor(sensor, &shapes, &closed, size)?;
         check_optical_thickness(&shapes, size)?;
         let (parent, sensor_medium) = nest_media(&shapes, &closed, &volume, sensor.point());
+        let solid = shapes
+            .iter()
+            .zip(&closed)
+            .map(|(s, &c)| c && s.surface.is_opaque() && !inside(s, sensor.point()))
+            .collect();
         Ok(Scene {
             shapes,
             parameters,
             parameter_shape,
             sensor,
             closed,
+            solid,
             parent,
             sensor_medium,
             size,
