@@ -65,6 +65,7 @@ pub mod plot;
 pub mod report;
 pub mod rng;
 pub mod rod;
+mod rows;
 pub mod runner;
 pub mod shard;
 pub mod stats;

@@ -547,3 +547,56 @@ fn a_sight_line_along_a_face_does_not_carry_paths_into_a_solid() {
         }
     }
 }
+
+#[test]
+fn a_row_with_too_many_numbers_is_refused_not_cut() {
+    // The TOML reader took the first three of `[0, 1, 2, 3]` and dropped the
+    // rest: a quad given as one row became one triangle, half the
+    // occluder, and the run answered for that (0.2024 against 0.1738).
+    let quad = "[sensor]\nkind = \"irradiance\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\
+         [[shapes]]\nname = \"lamp\"\n\
+         vertices = [[-0.5, -0.5, 2.0], [0.5, -0.5, 2.0], [0.5, 0.5, 2.0], [-0.5, 0.5, 2.0]]\n\
+         triangles = [[0, 1, 2], [0, 2, 3]]\nsurface = { kind = \"emitter\", radiance = 1.0 }\n\
+         [[shapes]]\nname = \"occ\"\n\
+         vertices = [[0.0, 0.0, 1.0], [0.3, 0.0, 1.0], [0.3, 0.3, 1.0], [0.0, 0.3, 1.0]]\n\
+         triangles = [[0, 1, 2, 3]]\nsurface = { kind = \"absorber\" }\n";
+    let path = scene_file("quad_row.toml", quad);
+    let args = [
+        "mesh",
+        "--scene",
+        path.to_str().unwrap(),
+        "--method",
+        "intensity",
+    ];
+    refused(
+        &args,
+        1,
+        &["triangle 0 has 4 indices, expected 3", "line 13"],
+    );
+    let path = scene_file(
+        "long_vertex.toml",
+        &quad
+            .replace("[0.3, 0.0, 1.0]", "[0.3, 0.0, 1.0, 7.0]")
+            .replace("[[0, 1, 2, 3]]", "[[0, 1, 2], [0, 2, 3]]"),
+    );
+    let args = [
+        "mesh",
+        "--scene",
+        path.to_str().unwrap(),
+        "--method",
+        "intensity",
+    ];
+    refused(&args, 1, &["vertex 1 has 4 coordinates, expected 3"]);
+    let flat_scene = scene_file(
+        "flat_z.toml",
+        &occluder(1.0, "").replacen("vertices = [[", "vertices = [[0.0, ", 1),
+    );
+    let args = [
+        "flat",
+        "--scene",
+        flat_scene.to_str().unwrap(),
+        "--method",
+        "intensity",
+    ];
+    refused(&args, 1, &["vertex 0 has 3 coordinates, expected 2"]);
+}

@@ -60,10 +60,18 @@ pub struct ShapeFile {
     /// Unique name, used by parameters.
     pub name: String,
     /// Inline vertex positions (with `triangles`; not with `mesh`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "crate::rows::points3"
+    )]
     pub vertices: Option<Vec<DVec3>>,
     /// Inline triangles, indices into `vertices` from 0.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "crate::rows::triangles"
+    )]
     pub triangles: Option<Vec<[u32; 3]>>,
     /// An OBJ file holding the mesh, relative to the scene file.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -70,6 +70,7 @@ pub struct Shape {
     /// Unique name, used by parameters.
     pub name: String,
     /// Vertices in order, as `[x, y]`.
+    #[serde(deserialize_with = "crate::rows::points2")]
     pub vertices: Vec<DVec2>,
     /// Whether the last vertex connects back to the first.
     #[serde(default)]
