@@ -110,6 +110,47 @@ fn image_size(est: &dyn Estimator, spp: u64) -> Result<(u32, u32), Error> {
     Ok(size)
 }
 
+/// Bytes an image holds per pixel and quantity at its peak, while its
+/// pixels' sums, their estimates and the planes written out coexist
+/// (measured: 405 MB for 1024² pixels of two quantities).
+pub const BYTES_PER_PIXEL: usize = 64
+    + std::mem::size_of::<PixelSums>()
+    + std::mem::size_of::<Estimate>()
+    + 4 * std::mem::size_of::<f64>();
+// The bound covers what a run was measured to hold.
+const _: () = assert!(BYTES_PER_PIXEL >= 193);
+
+/// The memory this machine has free, from `/proc/meminfo` (none where it
+/// cannot be read: no check).
+fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
+/// Refuses an image of `pixels` pixels and `quantities` images each whose
+/// sums would not fit in the memory free now, before the run: the
+/// allocation would otherwise fail hours in, and abort the process (a
+/// Python interpreter with it). `within`, where known, is the memory free.
+pub fn check_image_memory(
+    pixels: u64,
+    quantities: usize,
+    within: Option<u64>,
+) -> Result<(), Error> {
+    let need = (pixels as u128) * (quantities.max(1) as u128) * (BYTES_PER_PIXEL as u128);
+    match within {
+        Some(free) if need > u128::from(free) => Err(Error::Config(format!(
+            "the image needs about {:.1} GB ({pixels} pixels × {quantities} quantities × \
+             {BYTES_PER_PIXEL} bytes) and {:.1} GB of memory is free: render fewer pixels \
+             or fewer parameters",
+            need as f64 / 1e9,
+            free as f64 / 1e9
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// Renders rows `rows` of `est`'s camera, `spp` paths per pixel from
 /// `seed` on `threads` threads (0: all cores); `progress` is called with
 /// the number of rows done after each row. Returns, per pixel of those rows
@@ -127,6 +168,8 @@ pub fn render_rows(
     let (width, _) = image_size(est, spp)?;
     crate::runner::check_threads(threads)?;
     let nq = est.quantities().len();
+    let pixels = u64::from(width) * u64::from(rows.end.saturating_sub(rows.start));
+    check_image_memory(pixels, nq, available_memory())?;
     let done = std::sync::atomic::AtomicU64::new(0);
     let row = |r: u32| -> Vec<Vec<PixelSums>> {
         let out = (0..width)
@@ -199,7 +242,8 @@ pub fn assemble(
 /// `threads` threads (0: all cores); `progress` is called with the number of
 /// rows done after each row. Errors if the estimator has no camera, `spp`
 /// is below 2 or above [`MAX_SPP`], `threads` above
-/// [`MAX_THREADS`](crate::runner::MAX_THREADS), or the pool cannot start.
+/// [`MAX_THREADS`](crate::runner::MAX_THREADS), the image would not fit in
+/// the memory free ([`check_image_memory`]), or the pool cannot start.
 pub fn render(
     est: &dyn Estimator,
     spp: u64,
@@ -217,4 +261,23 @@ pub fn render(
         &pixels,
         seconds,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_image_larger_than_the_free_memory_is_refused_before_the_run() {
+        let gb = 1_000_000_000;
+        assert!(check_image_memory(1024 * 1024, 2, Some(23 * gb)).is_ok());
+        assert!(check_image_memory(8192 * 8192, 254, None).is_ok());
+        let err = check_image_memory(8192 * 8192, 2, Some(23 * gb))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("67108864 pixels × 2 quantities") && err.contains("23.0 GB"),
+            "{err}"
+        );
+    }
 }

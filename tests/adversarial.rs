@@ -600,3 +600,111 @@ fn a_row_with_too_many_numbers_is_refused_not_cut() {
     ];
     refused(&args, 1, &["vertex 0 has 3 coordinates, expected 2"]);
 }
+
+#[test]
+fn an_image_too_large_for_memory_is_refused_before_the_run() {
+    // 8192² pixels (inside the camera's limits) of 61 images each need
+    // about 10¹² bytes: the run aborted on a failed allocation ("memory
+    // allocation of 896 bytes failed", a Python interpreter with it) after
+    // minutes; now it is refused at once, saying what it needs.
+    let mut scene = String::from(
+        "[sensor]\nkind = \"camera\"\nposition = [0.1, 0.1, 0.5]\nlook_at = [0.1, 0.1, 2.0]\n\
+         up = [0.0, 1.0, 0.0]\nfov_deg = 90.0\nwidth = 8192\nheight = 8192\n\
+         [[shapes]]\nname = \"lamp\"\n\
+         vertices = [[-0.5, -0.5, 2.0], [0.5, -0.5, 2.0], [0.5, 0.5, 2.0], [-0.5, 0.5, 2.0]]\n\
+         triangles = [[0, 1, 2], [0, 2, 3]]\nsurface = { kind = \"emitter\", radiance = 1.0 }\n\
+         [[shapes]]\nname = \"tri\"\nvertices = [[0.0, 0.0, 1.0], [0.3, 0.0, 1.0], [0.0, 0.3, 1.0]]\n\
+         triangles = [[0, 1, 2]]\nsurface = { kind = \"absorber\" }\n",
+    );
+    for j in 0..60 {
+        scene += &format!(
+            "[[parameters]]\nname = \"p{j}\"\nshape = \"tri\"\nmotion = {{ kind = \"translate_x\" }}\n"
+        );
+    }
+    let path = scene_file("huge_camera.toml", &scene);
+    let out = path.with_extension("out");
+    let args = [
+        "render",
+        "--scene",
+        path.to_str().unwrap(),
+        "--method",
+        "rendering",
+        "--spp",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    refused(
+        &args,
+        1,
+        &["67108864 pixels × 61 quantities", "GB of memory is free"],
+    );
+    let written = std::fs::read_dir(&out).map_or(0, |d| d.count());
+    assert_eq!(written, 0, "nothing is written");
+}
+
+#[test]
+fn an_output_path_that_cannot_be_written_is_refused_before_the_run() {
+    // Found only once the work was done: a shard's state, a rendering's
+    // images or the comparison's figures were lost after the whole run.
+    // A regular file stands where a folder should be.
+    let blocker = scene_file("not_a_folder", "");
+    let under = |name: &str| blocker.join(name).to_str().unwrap().to_owned();
+    let occluder = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/occluder.toml");
+    let camera = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/mesh/camera_shadow.toml"
+    );
+    let state = under("x.json");
+    refused(
+        &[
+            "flat",
+            "--scene",
+            occluder,
+            "--method",
+            "rendering",
+            "--paths",
+            "100000000",
+            "--state",
+            &state,
+        ],
+        1,
+        &["cannot write to", "x.json"],
+    );
+    let images = under("images");
+    refused(
+        &[
+            "render",
+            "--scene",
+            camera,
+            "--method",
+            "rendering",
+            "--spp",
+            "100000",
+            "--out",
+            &images,
+        ],
+        1,
+        &["cannot write to", "images"],
+    );
+    let figures = under("figures");
+    refused(
+        &["compare", "--figures", &figures],
+        1,
+        &["cannot write to", "figures"],
+    );
+    let folder = blocker.parent().unwrap().to_str().unwrap().to_owned();
+    refused(
+        &[
+            "flat",
+            "--scene",
+            occluder,
+            "--method",
+            "rendering",
+            "--state",
+            &folder,
+        ],
+        1,
+        &["is a folder"],
+    );
+}

@@ -48,6 +48,7 @@ fn estimate(
         )
         .into());
     }
+    super::output::writable_file(path)?;
     let which = shard.shard.unwrap_or(Shard::WHOLE);
     let state = job.run_shard(&cfg, which)?;
     state.write(path)?;
@@ -168,6 +169,9 @@ pub(super) fn compare_command(
         .into());
     }
     let cfg = args.run.config(200_000)?;
+    if !args.no_figures {
+        super::output::writable_dir(&args.figures)?;
+    }
     let start = Instant::now();
     // Per method: total sampling time, largest z-score, unreliable estimates.
     let mut totals = [(0.0, 0.0f64, 0usize); 4];

@@ -258,6 +258,7 @@ fn exact_result(rod: &Rod, probe: &Probe) -> Result<RunResult, Error> {
 }
 
 mod commands;
+mod output;
 mod render;
 
 fn main() -> ExitCode {

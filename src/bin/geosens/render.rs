@@ -126,6 +126,7 @@ pub(super) fn render_command(
             )
             .into());
         }
+        super::output::writable_file(path)?;
         let which = args.shard.shard.unwrap_or(Shard::WHOLE);
         let state = job.run_shard(args.spp, args.seed, args.threads, which, &|_| {})?;
         state.write(path)?;
@@ -144,6 +145,7 @@ pub(super) fn render_command(
     }
     let dir = args.out.as_deref().ok_or("--out DIR is needed")?;
     let (estimator, _) = job.prepare()?;
+    super::output::writable_dir(dir)?;
     let rows = estimator.image().map_or(0, |(_, h)| h);
     let bar = indicatif::ProgressBar::new(u64::from(rows));
     bar.set_style(

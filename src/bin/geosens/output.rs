@@ -1,0 +1,39 @@
+//! Where a run's output goes, checked before the run: a path that cannot
+//! be written was found only when the work was done (a shard's state, a
+//! rendering's images or the comparison's figures lost after minutes or
+//! hours, a cluster job with them).
+use geosens::Error;
+use std::path::Path;
+
+/// Creates `dir` if missing and proves it writable with a file made and
+/// removed in it.
+pub(super) fn writable_dir(dir: &Path) -> Result<(), Error> {
+    let fail = |e: std::io::Error| Error::Output(format!("cannot write to {}: {e}", dir.display()));
+    std::fs::create_dir_all(dir).map_err(fail)?;
+    let probe = dir.join(format!(".geosens-probe-{}", std::process::id()));
+    std::fs::File::create(&probe).map_err(fail)?;
+    std::fs::remove_file(&probe).map_err(fail)
+}
+
+/// Proves `path` writable as a file: not a folder, and its folder exists and
+/// takes a file.
+pub(super) fn writable_file(path: &Path) -> Result<(), Error> {
+    if path.is_dir() {
+        return Err(Error::Output(format!(
+            "cannot write to {}: it is a folder",
+            path.display()
+        )));
+    }
+    let parent = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !parent.is_dir() {
+        return Err(Error::Output(format!(
+            "cannot write to {}: no folder {}",
+            path.display(),
+            parent.display()
+        )));
+    }
+    writable_dir(parent)
+}
