@@ -85,3 +85,40 @@ fn check_pair(shapes: &[Shape], k: usize, l: usize, boxes: &[Aabb], tol: f64) ->
     }
     Ok(())
 }
+
+/// Rejects a mesh with a medium whose triangles cross or touch one another
+/// (two boxes given as one mesh): a path finds the medium by the parity of
+/// the boundaries it crosses, which is wrong where the mesh overlaps
+/// itself. The same sweep over x as [`check_pair`], within one mesh;
+/// triangles that share a vertex are the mesh's own contact, not tested.
+/// Flatland refuses a polygon that intersects itself likewise.
+pub(super) fn check_self_crossings(shapes: &[Shape], size: f64) -> Result<(), Error> {
+    let tol = TOUCH_DISTANCE * size;
+    for s in shapes.iter().filter(|s| s.medium.is_some()) {
+        let mut items: Vec<(Aabb, u32)> = (0..s.triangles.len())
+            .map(|i| (Aabb::of(&s.triangle(i)), i as u32))
+            .collect();
+        items.sort_by(|a, b| a.0.lo.x.total_cmp(&b.0.lo.x));
+        let mut active: Vec<(Aabb, u32)> = Vec::new();
+        for &(b, i) in &items {
+            active.retain(|(o, _)| o.hi.x + tol >= b.lo.x);
+            let ti = s.triangles[i as usize];
+            for &(o, j) in &active {
+                let tj = s.triangles[j as usize];
+                if !b.meets(&o, tol) || ti.iter().any(|v| tj.contains(v)) {
+                    continue;
+                }
+                if triangles_within(s.triangle(i as usize), s.triangle(j as usize), tol) {
+                    let (a, b) = (i.min(j), i.max(j));
+                    return config(format!(
+                        "shape {:?} crosses itself (triangles {a} and {b}): a mesh with a \
+                         medium must bound one region",
+                        s.name
+                    ));
+                }
+            }
+            active.push((b, i));
+        }
+    }
+    Ok(())
+}

@@ -386,6 +386,51 @@ fn meshes_that_cross_or_touch_are_rejected() {
 }
 
 #[test]
+fn a_medium_whose_mesh_crosses_itself_is_rejected() {
+    // Two overlapping cubes given as one closed mesh: its parity of
+    // crossings would put the overlap outside the medium.
+    let two = |offset: DVec3| {
+        let (a, b) = (
+            fog("blob", DVec3::new(0.0, 0.0, 1.0), 0.3),
+            fog("b", DVec3::new(0.0, 0.0, 1.0) + offset, 0.3),
+        );
+        let mut vertices = a.vertices.clone();
+        vertices.extend(&b.vertices);
+        let mut triangles = a.triangles.clone();
+        triangles.extend(b.triangles.iter().map(|t| t.map(|i| i + 8)));
+        Shape {
+            vertices,
+            triangles,
+            ..a
+        }
+    };
+    assert_err(
+        vec![lamp(), two(DVec3::new(0.2, 0.1, 0.05))],
+        vec![],
+        irradiance(),
+        "shape \"blob\" crosses itself (triangles",
+    );
+    // Apart, the two cubes bound two regions of one medium: fine; so is one
+    // cube, whose triangles touch only where they share a vertex.
+    assert!(
+        Scene::new(
+            vec![lamp(), two(DVec3::new(0.7, 0.0, 0.0))],
+            vec![],
+            irradiance()
+        )
+        .is_ok()
+    );
+    assert!(
+        Scene::new(
+            vec![lamp(), fog("f", DVec3::new(0.0, 0.0, 1.0), 0.3)],
+            vec![],
+            irradiance()
+        )
+        .is_ok()
+    );
+}
+
+#[test]
 fn bad_parameters_and_sensors_are_rejected_with_a_reason() {
     let shapes = || vec![cube("a", DVec3::new(0.0, 0.0, 3.0), 1.0, Surface::Absorber)];
     let s = irradiance;

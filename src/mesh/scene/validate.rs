@@ -20,7 +20,7 @@
 //! welding keeps the triangles' order, so triangle indices in later
 //! messages are the user's too. Vertex indices in later messages are those
 //! of the welded mesh.
-use super::crossings::{Aabb, check_crossings};
+use super::crossings::{Aabb, check_crossings, check_self_crossings};
 use super::geometry::{point_triangle_distance, signed_volume, winding_number};
 use super::{
     MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion, Parameter, Scene, Sensor, Shape, Surface,
@@ -93,7 +93,8 @@ impl Scene {
     /// albedo ∉ `[0, 1]`), a medium too thick ([`MAX_OPTICAL_THICKNESS`]), a
     /// size outside [`MIN_SIZE`](super::MIN_SIZE)..[`MAX_SIZE`](super::MAX_SIZE) or
     /// too far from the origin ([`MAX_OFFSET`](super::MAX_OFFSET)), two meshes that cross or
-    /// touch ([`TOUCH_DISTANCE`]), bad parameters (too many, empty or
+    /// touch ([`TOUCH_DISTANCE`]), a mesh with a medium that crosses itself,
+    /// bad parameters (too many, empty or
     /// repeated names, unknown shapes, zero or non-finite axes and pivots),
     /// a non-finite sensor, a sensor on a surface or inside an opaque closed
     /// mesh.
@@ -128,6 +129,7 @@ impl Scene {
             }
         }
         check_crossings(&shapes, size)?;
+        check_self_crossings(&shapes, size)?;
         let volume = orient(&mut shapes, &closed)?;
         let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters)?;
         let sensor = check_sensor(sensor, &shapes, &closed, size)?;
