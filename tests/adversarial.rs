@@ -708,3 +708,47 @@ fn an_output_path_that_cannot_be_written_is_refused_before_the_run() {
         &["is a folder"],
     );
 }
+
+#[test]
+fn a_pivot_far_from_its_shape_is_refused() {
+    // A rotation about a pivot 10¹⁶⁰ away read 0 with no warning, one
+    // 10¹⁰⁰ away printed NaN diagnostics: such a motion is a translation
+    // of enormous speed. 10⁶ sizes away is the bound, as for the scene's
+    // offset from the origin.
+    for (far, refused_here) in [(1e160, true), (1e100, true), (1e5, false)] {
+        let extra = format!(
+            "[[parameters]]\nname = \"spin\"\nshape = \"occ\"\n\
+             motion = {{ kind = \"rotate\", pivot = [{far:e}, 1.0] }}\n"
+        );
+        let path = scene_file("far_pivot.toml", &occluder(1.0, &extra));
+        let args = flat(&path, "rendering", "2000");
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        if refused_here {
+            refused(&args, 1, &["\"spin\"", "pivot lies", "at most"]);
+        } else {
+            let (code, _, err) = geosens(&args);
+            assert_eq!(code, 0, "{err}");
+        }
+    }
+    use geosens::mesh::cases::{lamp, square_shape, up};
+    use glam::DVec3;
+    let square = square_shape(
+        "sq",
+        DVec3::new(0.0, 0.0, 1.0),
+        0.1,
+        geosens::mesh::Surface::Absorber,
+    );
+    let spin = |far: f64| geosens::mesh::Parameter {
+        name: "spin".into(),
+        shape: "sq".into(),
+        motion: geosens::mesh::Motion::Rotate {
+            axis: DVec3::Z,
+            pivot: Some(DVec3::new(far, 0.0, 1.0)),
+        },
+    };
+    let scene =
+        |far| geosens::mesh::Scene::new(vec![lamp(), square.clone()], vec![spin(far)], up());
+    assert!(scene(1e5).is_ok());
+    let err = scene(1e200).unwrap_err().to_string();
+    assert!(err.contains("pivot lies 1e200"), "{err}");
+}

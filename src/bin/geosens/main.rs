@@ -123,7 +123,7 @@ struct SceneArgs {
 struct FdArgs {
     /// Half step of `--method fd`: relative to the scene's size (the rod's
     /// length) for a translation, radians for a rotation, the relative
-    /// change for a scale; in (0, 1) [default: 0.001].
+    /// change for a scale; in [1e-12, 1) [default: 0.001].
     #[arg(long, allow_hyphen_values = true)]
     fd_step: Option<f64>,
 }

@@ -19,6 +19,7 @@ mod tests;
 mod validate;
 
 pub(crate) use validate::check_extent;
+pub(crate) use validate::check_pivot;
 pub use validate::{MAX_OFFSET, MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE};
 
 /// Largest extinction coefficient times scene size accepted: beyond it a

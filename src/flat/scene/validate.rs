@@ -35,7 +35,7 @@ impl Scene {
             normal,
         } = outline(&shapes, size)?;
         check_crossings(&shapes, &segments, &owner)?;
-        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters)?;
+        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters, size)?;
         let sensor = check_sensor(sensor, &shapes, &segments, &owner, size)?;
         check_optical_thickness(&shapes, size)?;
         let (parent, sensor_medium) = nest_media(&shapes, sensor.point());
@@ -140,6 +140,24 @@ pub(crate) fn check_extent(size: f64, far: f64) -> Result<f64, Error> {
         ));
     }
     Ok(size)
+}
+
+/// Refuses a pivot farther than [`MAX_OFFSET`] sizes from the shape it
+/// turns or scales (`distance`, along the farthest axis: a length would
+/// overflow): the motion's velocities grow with that
+/// distance, and past it a rotation read 0 with no warning (pivot 10¹⁶⁰
+/// away) or its diagnostics NaN (10¹⁰⁰). Flatland's and 3D's validation
+/// both.
+pub(crate) fn check_pivot(name: &str, distance: f64, size: f64) -> Result<(), Error> {
+    if distance > MAX_OFFSET * size {
+        return config(format!(
+            "parameter {name:?}: its pivot lies {distance:e} from the shape it moves, {:.1e} \
+             times the scene's size {size:e}: at most {MAX_OFFSET:e} times is supported \
+             (such a rotation or scale is a translation of enormous speed)",
+            distance / size
+        ));
+    }
+    Ok(())
 }
 
 /// Smallest and largest scene size accepted: within them every squared
@@ -342,6 +360,7 @@ fn check_crossings(shapes: &[Shape], segments: &[Segment], owner: &[u32]) -> Res
 fn resolve_parameters(
     shapes: &[Shape],
     parameters: &[Parameter],
+    size: f64,
 ) -> Result<(Vec<Parameter>, Vec<u32>), Error> {
     let mut parameter_shape = Vec::with_capacity(parameters.len());
     let mut resolved = Vec::with_capacity(parameters.len());
@@ -369,11 +388,21 @@ fn resolve_parameters(
             Motion::Rotate { pivot } => {
                 let c = pivot.unwrap_or_else(|| shapes[k].centroid());
                 finite(&format!("parameter {:?} pivot", p.name), c)?;
+                check_pivot(
+                    &p.name,
+                    (c - shapes[k].centroid()).abs().max_element(),
+                    size,
+                )?;
                 Motion::Rotate { pivot: Some(c) }
             }
             Motion::Scale { pivot } => {
                 let c = pivot.unwrap_or_else(|| shapes[k].centroid());
                 finite(&format!("parameter {:?} pivot", p.name), c)?;
+                check_pivot(
+                    &p.name,
+                    (c - shapes[k].centroid()).abs().max_element(),
+                    size,
+                )?;
                 Motion::Scale { pivot: Some(c) }
             }
             m => m,

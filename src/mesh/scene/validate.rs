@@ -131,7 +131,7 @@ impl Scene {
         check_crossings(&shapes, size)?;
         check_self_crossings(&shapes, size)?;
         let volume = orient(&mut shapes, &closed)?;
-        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters)?;
+        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters, size)?;
         let sensor = check_sensor(sensor, &shapes, &closed, size)?;
         check_optical_thickness(&shapes, size)?;
         let (parent, sensor_medium) = nest_media(&shapes, &closed, &volume, sensor.point());
@@ -395,6 +395,7 @@ fn orient(shapes: &mut [Shape], closed: &[bool]) -> Result<Vec<f64>, Error> {
 fn resolve_parameters(
     shapes: &[Shape],
     parameters: &[Parameter],
+    size: f64,
 ) -> Result<(Vec<Parameter>, Vec<u32>), Error> {
     if parameters.len() > MAX_PARAMETERS {
         return config(format!(
@@ -421,6 +422,8 @@ fn resolve_parameters(
         let pivot = |pivot: Option<DVec3>| -> Result<Option<DVec3>, Error> {
             let c = pivot.unwrap_or_else(|| shapes[k].centroid());
             finite(&format!("parameter {:?} pivot", p.name), c)?;
+            let distance = (c - shapes[k].centroid()).abs().max_element();
+            crate::flat::scene::check_pivot(&p.name, distance, size)?;
             Ok(Some(c))
         };
         let motion = match p.motion {
