@@ -219,9 +219,16 @@ impl State {
     /// Reads a state from JSON; errors if it is not one or of another
     /// format.
     pub fn from_json(text: &str) -> Result<State, Error> {
-        let format = serde_json::from_str::<serde_json::Value>(text)
-            .ok()
-            .and_then(|v| v.get("format").and_then(|f| f.as_str().map(str::to_owned)));
+        // A cut or damaged file says so, not "no format".
+        let value = serde_json::from_str::<serde_json::Value>(text.trim_start_matches('\u{feff}'))
+            .map_err(|e| {
+                Error::Merge(format!(
+                    "not a geosens state: not JSON (cut short or damaged?): {e}"
+                ))
+            })?;
+        let format = value
+            .get("format")
+            .and_then(|f| f.as_str().map(str::to_owned));
         match format.as_deref() {
             Some(STATE_FORMAT) => {}
             Some(other) => {
@@ -231,7 +238,34 @@ impl State {
             }
             None => return Err(Error::Merge("not a geosens state (no \"format\")".into())),
         }
-        serde_json::from_str(text).map_err(|e| Error::Merge(format!("a malformed state: {e}")))
+        let state: State = serde_json::from_value(value)
+            .map_err(|e| Error::Merge(format!("a malformed state: {e}")))?;
+        state.check()?;
+        Ok(state)
+    }
+
+    /// Refuses a state that contradicts itself (an edited or damaged file
+    /// merged without complaint: more non-zero weights than weights, a
+    /// negative time printed as such).
+    fn check(&self) -> Result<(), Error> {
+        let bad = |what: String| Err(Error::Merge(format!("a damaged state: {what}")));
+        if !(self.seconds.is_finite() && self.seconds >= 0.0) {
+            return bad(format!("its time is {} s", self.seconds));
+        }
+        let packed: Vec<&[u64]> = match &self.payload {
+            Payload::Blocks { moments, .. } => moments.iter().flatten().map(|p| &p[..]).collect(),
+            Payload::Rows { pixels, .. } => pixels.iter().flatten().map(|p| &p[..9]).collect(),
+        };
+        for p in packed {
+            let (n, nonzero, jumps) = (p[0], p[1], p[8]);
+            if nonzero > n {
+                return bad(format!("{nonzero} non-zero weights among {n}"));
+            }
+            if jumps != NO_JUMPS && jumps > n {
+                return bad(format!("{jumps} jumps among {n} weights"));
+            }
+        }
+        Ok(())
     }
 
     /// Writes the state to `path` as one line of JSON, through a temporary

@@ -752,3 +752,18 @@ fn a_pivot_far_from_its_shape_is_refused() {
     let err = scene(1e200).unwrap_err().to_string();
     assert!(err.contains("pivot lies 1e200"), "{err}");
 }
+
+#[test]
+fn a_json_scene_with_a_byte_order_mark_loads() {
+    // Some editors start a UTF-8 file with U+FEFF; TOML allows it, and the
+    // JSON reader said "expected value at line 1 column 1".
+    let json = "\u{feff}{\"sensor\": {\"kind\": \"irradiance\", \"point\": [0.0, 0.0], \
+         \"normal\": [0.0, 1.0]}, \"shapes\": [{\"name\": \"lamp\", \
+         \"vertices\": [[-1.0, 2.0], [1.0, 2.0]], \"surface\": {\"kind\": \"emitter\", \
+         \"radiance\": 1.0}}]}";
+    let path = scene_file("bom.json", json);
+    let args = flat(&path, "intensity", "1000");
+    let (code, out, err) = geosens(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("\"intensity\""), "{out}");
+}

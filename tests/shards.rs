@@ -334,6 +334,35 @@ fn states_that_are_not_one_whole_run_are_refused() {
         err.contains("should hold blocks") && err.contains("damaged"),
         "{err}"
     );
+    // Cut short, and edited into contradictions (all were merged, or
+    // misreported as having no format).
+    let text = std::fs::read_to_string(s2).unwrap();
+    let cut = dir.join("cut.json");
+    std::fs::write(&cut, &text[..text.len() / 2]).unwrap();
+    let err = refused(&["merge", s1, cut.to_str().unwrap(), s3]);
+    assert!(
+        err.contains("cut.json") && err.contains("cut short"),
+        "{err}"
+    );
+    let mut v: Value = serde_json::from_str(&text).unwrap();
+    v["seconds"] = Value::from(-1.0);
+    let slow = dir.join("slow.json");
+    std::fs::write(&slow, v.to_string()).unwrap();
+    let err = refused(&["merge", s1, slow.to_str().unwrap(), s3]);
+    assert!(
+        err.contains("damaged") && err.contains("time is -1"),
+        "{err}"
+    );
+    let mut v: Value = serde_json::from_str(&text).unwrap();
+    let n = v["payload"]["moments"][0][0][0].as_u64().unwrap();
+    v["payload"]["moments"][0][0][1] = Value::from(n + 5);
+    let many = dir.join("many.json");
+    std::fs::write(&many, v.to_string()).unwrap();
+    let err = refused(&["merge", s1, many.to_str().unwrap(), s3]);
+    assert!(
+        err.contains("damaged") && err.contains("non-zero weights among"),
+        "{err}"
+    );
     // A shard count no run has (it would allocate a slot per shard).
     let mut v: Value = serde_json::from_str(&std::fs::read_to_string(s1).unwrap()).unwrap();
     v["run"]["shards"] = Value::from(u64::MAX);

@@ -133,7 +133,8 @@ pub(crate) fn parse_file<T>(
         }
     };
     let text = read_capped(path)?;
-    parse(&text).map_err(|e| in_file(path, e))
+    // A byte-order mark, as some editors write: TOML allows it, JSON not.
+    parse(text.trim_start_matches('\u{feff}')).map_err(|e| in_file(path, e))
 }
 
 /// Largest scene file read (bytes): a path that names an endless stream
