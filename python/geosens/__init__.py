@@ -49,12 +49,28 @@ StateLike = Union[Dict[str, Any], str, "os.PathLike[str]"]
 
 
 def _uint(name: str, value: Any) -> int:
-    """``value`` if it is an integer ≥ 0, else ValueError (Rust takes u64)."""
-    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+    """``value`` if it is an integer from 0 to 2⁶⁴ − 1, else ValueError
+    (Rust takes u64; past it, pyo3 raised an OverflowError naming nothing)."""
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, int)
+        or not 0 <= value < 2**64
+    ):
         raise ValueError(
-            f"invalid value {value!r} for {name}: expected an integer ≥ 0"
+            f"invalid value {value!r} for {name}: expected an integer from 0 to 2^64 - 1"
         )
     return value
+
+
+def _real(name: str, value: Any) -> float:
+    """``value`` as a float if it is a number (numpy's too), else ValueError:
+    ``float("2.1")`` would take a string silently."""
+    if isinstance(value, (str, bytes, bool)):
+        raise ValueError(f"invalid value {value!r} for {name}: expected a number")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"invalid value {value!r} for {name}: expected a number") from None
 
 
 def _shard(shard: Optional[ShardSpec]) -> Optional[Tuple[int, int]]:
@@ -70,7 +86,7 @@ def _shard(shard: Optional[ShardSpec]) -> Optional[Tuple[int, int]]:
 
 
 def _fd_step(fd_step: Optional[float]) -> Optional[float]:
-    return None if fd_step is None else float(fd_step)
+    return None if fd_step is None else _real("fd_step", fd_step)
 
 
 def _plain(value: Any) -> Any:
@@ -161,11 +177,11 @@ def rod(
     return _result(
         _geosens.rod(
             method,
-            float(ks),
-            float(ke),
-            float(length),
-            float(x),
-            float(omega),
+            _real("ks", ks),
+            _real("ke", ke),
+            _real("length", length),
+            _real("x", x),
+            _real("omega", omega),
             _uint("paths", paths),
             _uint("seed", seed),
             _uint("threads", threads),

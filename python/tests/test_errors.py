@@ -93,5 +93,11 @@ def test_python_side_checks():
     assert "seed" in raises(geosens.rod, "exact", 0.07, 0.1, 2, 1, 1, seed=1.5)
     assert "scene" in raises(geosens.flat, 42, "expectation")
     assert "shard" in raises(geosens.flat, OCC, "expectation", shard=3)
+    # Past u64 pyo3 raised an OverflowError naming nothing; a string was
+    # taken for a number.
+    assert "paths" in raises(geosens.flat, OCC, "expectation", paths=2**64)
+    assert "seed" in raises(geosens.rod, "exact", 0.07, 0.1, 2, 1, 1, seed=2**70)
+    assert "ks" in raises(geosens.rod, "exact", "0.07", 0.1, 2, 1, 1)
+    assert "fd_step" in raises(geosens.flat, OCC, "fd", fd_step="0.01")
     with pytest.raises(ValueError, match="not a geosens state"):
         geosens.merge([{"a": 1}])
