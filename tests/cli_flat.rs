@@ -220,11 +220,12 @@ fn bad_fd_steps_are_rejected_with_their_name() {
         ("1", "fd-step = 1"),
         ("nan", "fd-step = NaN"),
         ("inf", "fd-step = inf"),
+        ("1e-17", "fd-step = 1e-17"),
     ] {
         assert_flat_rejected(
             &path,
             &["--method", "fd", "--paths", "1000", "--fd-step", value],
-            &[shown, "(0, 1)"],
+            &[shown, "from 1e-12", "up to 1"],
         );
     }
     // A step for a method without one is a mistake, not a no-op.
