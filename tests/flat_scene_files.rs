@@ -179,7 +179,11 @@ name = "occluder""#;
             "wrong type of a vertex",
             "[0.2, 1.0]]",
             "[0.2]]",
-            &["line 14", "vertices", "vertex 1 has 1 coordinates, expected 2"],
+            &[
+                "line 14",
+                "vertices",
+                "vertex 1 has 1 coordinates, expected 2",
+            ],
         ),
         (
             "wrong type in the sensor",

@@ -901,7 +901,7 @@ impl Boundaries for Space {
     #[inline]
     fn off_boundary(&self, b: &BoundaryPoint<DVec3>, p: Prim) -> DVec3 {
         let d = self.face_inward(b.index as usize, p);
-        b.q + d * (1e-9 * self.scene.size())
+        b.q + d * crate::path::Geometry::nudge(self, b.q)
     }
 
     /// The fibre warp of [`super::warp`].

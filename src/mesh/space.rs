@@ -493,6 +493,15 @@ impl Geometry for Space {
         self.normals[p as usize]
     }
     #[inline]
+    fn nudge(&self, y: DVec3) -> f64 {
+        // A thousand times the casters' floor at y (`bvh::ROUNDING_ULPS`
+        // ulps of its largest coordinate): a nested path's first hit on
+        // the surface it left is then skipped only at grazing angles.
+        // Within 70 sizes of the origin this is 10⁻⁹ of the size.
+        let floor = super::bvh::ROUNDING_ULPS * f64::EPSILON * y.abs().max_element();
+        (1e-9 * self.scene.size()).max(1e3 * floor)
+    }
+    #[inline]
     fn solid(&self, p: Prim) -> bool {
         self.scene.is_solid(self.owner[p as usize])
     }

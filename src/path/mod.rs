@@ -269,6 +269,16 @@ pub trait Geometry: Sync {
     /// Unit normal of primitive `p` at its point `y` (outward for closed
     /// shapes).
     fn normal(&self, p: Prim, y: Self::V) -> Self::V;
+    /// How far off a surface, an interface or a boundary point at `y` a
+    /// nested path starts: 10⁻⁹ of the scene's size, and far from the
+    /// origin (3D) enough more that the casters, which skip hits within
+    /// the rounding of their coordinates, still see the surface it left
+    /// (at 10⁵ sizes from the origin a moving fog's derivative was 4× off
+    /// with the fixed step).
+    #[inline]
+    fn nudge(&self, _y: Self::V) -> f64 {
+        1e-9 * self.size()
+    }
     /// Whether primitive `p` bounds a solid no path reaches the inside of:
     /// flatland's closed opaque polygons, 3D's closed opaque meshes the
     /// sensor is outside (around the sensor, one is a room). A ray that meets such a primitive from

@@ -126,7 +126,7 @@ pub(super) fn leibniz<G: Geometry>(
     }
     // Just before the boundary, but farther than the caster's hit
     // threshold even for a nested walk that starts a hair in front of it.
-    let end = x + w * (t_b - (1e-9 * g.size()).min(0.5 * t_b));
+    let end = x + w * (t_b - g.nudge(x + w * t_b).min(0.5 * t_b));
     let wi = g.phase_lobe(medium, w).sample(rng);
     let ls = radiance(g, rng, end, wi, medium, NO_PRIM);
     let term = beta * ks * (-ke * t_b).exp() * ls;
@@ -241,7 +241,7 @@ fn corner_term<G: Boundaries>(
     // light the jump is made of (an absorbing tetrahedron with a face
     // 3·10⁻⁵ rad from edge-on lost 13 % of its derivative). The step takes
     // such a face's plane behind the ray's origin down to γ ~ 10⁻⁷.
-    let past = b.q + wq * (1e-9 * g.size());
+    let past = b.q + wq * g.nudge(b.q);
     let side = |rng: &mut PathRng, side: Side| match side {
         Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(b, p), p, wq, medium),
         Side::Past => radiance(g, rng, past, wq, medium, NO_PRIM),

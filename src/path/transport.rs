@@ -76,7 +76,7 @@ impl<G: Boundaries> Transport<'_, G> {
             nested.slots[j].u = g.velocity(j, y);
             nested.touch(j);
         }
-        let start = y - w * (1e-9 * g.size()).min(0.5 * (y - x).length());
+        let start = y - w * g.nudge(y).min(0.5 * (y - x).length());
         let nested = self.frozen_walk(g, rng, nested, start, w, medium, NO_PRIM, drawn);
         for j in self.slots.parameter_slots.iter() {
             let n = &nested.slots[j];
@@ -224,7 +224,7 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             return;
         }
         let (w, before, beta) = (leg.w, leg.medium, leg.beta);
-        let eps = 1e-9 * g.size();
+        let eps = g.nudge(y);
         let side = |rng: &mut PathRng, medium: MediumId, at: G::V| match g.coefficients(medium) {
             Some((ks, _)) if ks > 0.0 => {
                 let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
