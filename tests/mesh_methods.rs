@@ -987,7 +987,7 @@ fn a_face_nearly_edge_on_does_not_hide_its_silhouettes_jump() {
     let fd_caveat = |step: f64| {
         use geosens::Estimator;
         let fd = geosens::mesh::methods::finite_difference(&scene, step).unwrap();
-        fd.caveats()
+        geosens::Estimator::caveats(&fd)
             .into_iter()
             .find(|(q, _)| *q == Quantity::sensitivity("rot"))
     };
@@ -1160,4 +1160,68 @@ fn a_moving_fog_far_from_the_origin_keeps_its_derivatives() {
             assert!(z.abs() < 4.0, "{m} {q:?}: {a:?} at the origin, {b:?} far");
         }
     }
+}
+
+#[test]
+fn a_step_wider_than_the_lamp_is_a_caveat_for_finite_differences() {
+    // A lamp 10⁻³ wide (radiance 10⁶) at z = 2, a black triangle at z = 1
+    // whose edge shadows part of it: dI/dtx = 2 L a / d² = 500 exactly
+    // (a the lamp's side, d = 2: the edge's shadow sweeps the lamp at
+    // twice its own speed). At the default step one half step moves the
+    // edge's shadow past the lamp: the quotient saturated at 125.000 ±
+    // 7·10⁻⁹, marked reliable.
+    let a = 1e-3;
+    let lamp = Shape {
+        name: "lamp".into(),
+        vertices: [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .map(|(x, y)| DVec3::new(0.5 * a * x, 0.5 * a * y, 2.0))
+            .to_vec(),
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        surface: Surface::Emitter { radiance: 1e6 },
+        medium: None,
+    };
+    let tri = Shape {
+        name: "tri".into(),
+        vertices: vec![
+            DVec3::new(0.0002, -0.3, 1.0),
+            DVec3::new(0.3, 0.0, 1.0),
+            DVec3::new(0.0002, 0.3, 1.0),
+        ],
+        triangles: vec![[0, 1, 2]],
+        surface: Surface::Absorber,
+        medium: None,
+    };
+    let scene = Arc::new(
+        Scene::new(
+            vec![lamp, tri],
+            params("tri", &[("tx", Motion::TranslateX)]),
+            up(),
+        )
+        .unwrap(),
+    );
+    // The shadow's edge x_s = 4·10⁻⁴ on the lamp moves at 2 per unit tx and
+    // uncovers radiance L seen with the kernel cos θ cos θ' / r² = 4/r⁴:
+    // dE/dtx = 2 L ∫ 4/(c² + y²)² dy over the lamp's side, c² = 4 + x_s²
+    // (500 up to 10⁻⁷: rendering resolves the difference).
+    let (c2, half) = (4.0 + 4e-4f64 * 4e-4, 0.5 * a);
+    let c = c2.sqrt();
+    let primitive = |y: f64| y / (2.0 * c2 * (c2 + y * y)) + (y / c).atan() / (2.0 * c2 * c);
+    let exact = 2.0 * 1e6 * 4.0 * (primitive(half) - primitive(-half));
+    assert!((exact - 500.0).abs() < 1e-4, "{exact}");
+    let q = Quantity::sensitivity("tx");
+    let caveat = |step: f64| {
+        let fd = geosens::mesh::methods::finite_difference(&scene, step).unwrap();
+        geosens::Estimator::caveats(&fd)
+            .iter()
+            .any(|(c, why)| *c == q && why.contains("cross the lamp"))
+    };
+    assert!(caveat(geosens::fd::DEFAULT_STEP));
+    assert!(!caveat(1e-5));
+    let fine = geosens::mesh::methods::finite_difference(&scene, 1e-5).unwrap();
+    let r = run(&fine, &RunConfig::new(400_000, 2).unwrap()).unwrap();
+    let e = r.get(&q).unwrap();
+    assert!(e.z_score(exact) < 4.0, "{e:?} against {exact}");
+    let r = estimate(&scene, Method::Rendering, 100_000, 2);
+    let e = r.get(&q).unwrap();
+    assert!(e.z_score(exact) < 4.0, "{e:?} against {exact}");
 }
