@@ -987,7 +987,7 @@ fn a_face_nearly_edge_on_does_not_hide_its_silhouettes_jump() {
     let fd_caveat = |step: f64| {
         use geosens::Estimator;
         let fd = geosens::mesh::methods::finite_difference(&scene, step).unwrap();
-        geosens::Estimator::caveats(&fd)
+        fd.caveats()
             .into_iter()
             .find(|(q, _)| *q == Quantity::sensitivity("rot"))
     };
