@@ -1225,3 +1225,55 @@ fn a_step_wider_than_the_lamp_is_a_caveat_for_finite_differences() {
     let e = r.get(&q).unwrap();
     assert!(e.z_score(exact) < 4.0, "{e:?} against {exact}");
 }
+
+#[test]
+fn edges_of_one_mesh_aligned_from_the_sensor_are_a_caveat_too() {
+    // One mesh of two black quads: the near one (z = 1) ends at x = 0.2,
+    // the far one (z = 1.5) starts at x = 0.3 + dx; at dx = 0 both edges
+    // lie in the plane x = 0.2 z through the sensor and the lamp is just
+    // hidden. Moving the mesh left opens a gap (one-sided derivative
+    // −0.148), right does not (0): rendering read 0.0049 and finite
+    // differences −0.074, both marked reliable.
+    let pair = |dx: f64| Shape {
+        name: "pair".into(),
+        vertices: vec![
+            DVec3::new(-0.6, -0.6, 1.0),
+            DVec3::new(0.2, -0.6, 1.0),
+            DVec3::new(0.2, 0.6, 1.0),
+            DVec3::new(-0.6, 0.6, 1.0),
+            DVec3::new(0.3 + dx, -0.9, 1.5),
+            DVec3::new(0.9, -0.9, 1.5),
+            DVec3::new(0.9, 0.9, 1.5),
+            DVec3::new(0.3 + dx, 0.9, 1.5),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]],
+        surface: Surface::Absorber,
+        medium: None,
+    };
+    for (dx, tied) in [(0.0, true), (1e-6, false)] {
+        let parameters = params("pair", &[("tx", Motion::TranslateX)]);
+        let scene = Arc::new(Scene::new(vec![lamp(), pair(dx)], parameters, up()).unwrap());
+        for m in [
+            Method::Rendering,
+            Method::Transport,
+            Method::Expectation,
+            Method::Fd,
+        ] {
+            let caveats = m.estimator(Arc::clone(&scene)).unwrap().caveats();
+            let on = |q: &Quantity| {
+                caveats
+                    .iter()
+                    .any(|(c, why)| c == q && why.contains("edges of mesh \"pair\""))
+            };
+            assert_eq!(
+                on(&Quantity::sensitivity("tx")),
+                tied,
+                "{m} at {dx}: {caveats:?}"
+            );
+            if m == Method::Transport {
+                // The sensor's own motion crosses the same kink.
+                assert_eq!(on(&Quantity::gradient("x")), tied, "{caveats:?}");
+            }
+        }
+    }
+}
