@@ -24,6 +24,7 @@ use crate::method::{Method, Problem};
 use crate::path::deform::Slots;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::intensity::IntensityEstimator;
+use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
 impl Problem for Arc<Scene> {
@@ -344,7 +345,23 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
         let (nl, la) = (n.length(), ra.length());
         let u = ra / la;
         let angle = |r: glam::DVec3| (n.dot(u.cross(r)) / nl).atan2(u.dot(r));
-        let (a0, a1) = (0.0f64.min(angle(rb)), 0.0f64.max(angle(rb)));
+        // Each edge's arc of sight lines in the plane: a start angle and a
+        // length below π (a segment off the sensor subtends less); two arcs
+        // overlap when either's start lies strictly inside the other. (As
+        // min/max of angles in (−π, π], an arc across the back, a room's
+        // corner edge behind the sensor, had spanned the whole circle and
+        // tied with everything.)
+        let arc = |p: glam::DVec3, q: glam::DVec3| {
+            let (tp, tq) = (angle(p), angle(q));
+            let sweep = (tq - tp + PI).rem_euclid(TAU) - PI;
+            if sweep >= 0.0 {
+                (tp, sweep)
+            } else {
+                (tq, -sweep)
+            }
+        };
+        let inside = |start: f64, arc: (f64, f64)| (start - arc.0).rem_euclid(TAU) < arc.1;
+        let arc_a = arc(ra, rb);
         let reach = slack + widest;
         for key in [unit.dot(key_axis), -unit.dot(key_axis)] {
             let from = planes.partition_point(|p| p.0 < key - reach);
@@ -366,8 +383,8 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
                 if !(off(qa) && off(qb)) {
                     continue;
                 }
-                let (b0, b1) = (angle(qa).min(angle(qb)), angle(qa).max(angle(qb)));
-                if a0.max(b0) < a1.min(b1) {
+                let arc_b = arc(qa, qb);
+                if inside(arc_b.0, arc_a) || inside(arc_a.0, arc_b) {
                     tied.push((a.shape, b.shape));
                 }
             }
