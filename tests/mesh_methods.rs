@@ -1291,6 +1291,35 @@ fn edges_of_one_mesh_aligned_from_the_sensor_are_a_caveat_too() {
         !caveats.iter().any(|(_, why)| why.contains("one plane")),
         "{caveats:?}"
     );
+    // A box whose face x = 0 holds the sensor: its top and bottom edges
+    // there tie, but a motion along the face slides them along the tie
+    // (tz: smooth, no caveat), while one across it is a kink (tx).
+    let face_on = cube(
+        "box",
+        DVec3::new(0.15, 0.0, 1.15),
+        0.15,
+        Surface::Absorber,
+        None,
+    );
+    let parameters = params(
+        "box",
+        &[("tx", Motion::TranslateX), ("tz", Motion::TranslateZ)],
+    );
+    let scene = Arc::new(Scene::new(vec![lamp(), face_on], parameters, up()).unwrap());
+    for m in [
+        Method::Rendering,
+        Method::Transport,
+        Method::Expectation,
+        Method::Fd,
+    ] {
+        let caveats = m.estimator(Arc::clone(&scene)).unwrap().caveats();
+        let on = |name: &str| {
+            caveats
+                .iter()
+                .any(|(c, _)| *c == Quantity::sensitivity(name))
+        };
+        assert!(on("tx") && !on("tz"), "{m}: {caveats:?}");
+    }
 }
 
 #[test]

@@ -95,23 +95,11 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Spac
         });
     let geometry = Space::new(scene);
     let mut caveats = caveats;
-    let ties = edge_ties(&geometry);
-    // Moving the sensor moves it off the plane of tied edges too: its
-    // gradient has the same kink.
-    if gradient && let Some((_, why)) = ties.first() {
-        let why = why.split(": I may").next().unwrap_or(why).to_owned();
-        for axis in ["x", "y", "z"] {
-            caveats.push((
-                Quantity::gradient(axis),
-                format!(
-                    "{why}: I may have a kink along the sensor's {axis} (the one-sided \
-                     derivatives differ) and the estimate is one of them or neither"
-                ),
-            ));
-        }
-    }
-    for (q, why) in ties {
-        if !caveats.iter().any(|c: &(Quantity, String)| c.0 == q) {
+    // Ties also kink the sensor's gradient (its motion off their plane),
+    // where transport estimates it.
+    for (q, why) in edge_ties(&geometry) {
+        let wanted = gradient || matches!(q, Quantity::Sensitivity(_));
+        if wanted && !caveats.iter().any(|c: &(Quantity, String)| c.0 == q) {
             caveats.push((q, why));
         }
     }
@@ -334,7 +322,8 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
         }
     }
     planes.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut tied: Vec<(u32, u32)> = Vec::new();
+    // (moved mesh, other mesh, the plane's unit normal, the moved edge's ends)
+    let mut tied: Vec<(u32, u32, glam::DVec3, [glam::DVec3; 2])> = Vec::new();
     for &i in seen.iter().filter(|&&i| moved(t.edges[i].shape)) {
         let Some((unit, slack)) = plane(i) else {
             continue; // an edge pointing at the sensor: no plane
@@ -373,9 +362,7 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
                 // shadow edge on the other's: rendering 0.0049, finite
                 // differences −0.074, the one-sided −0.148 and 0).
                 let touching = [a.a, a.b].iter().any(|p| *p == b.a || *p == b.b);
-                if (b.shape == a.shape && (k == i || touching))
-                    || tied.contains(&(a.shape, b.shape))
-                {
+                if (b.shape == a.shape && (k == i || touching)) || tied.len() >= MAX_TIES {
                     continue;
                 }
                 let (qa, qb) = (b.a - x, b.b - x);
@@ -385,37 +372,62 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
                 }
                 let arc_b = arc(qa, qb);
                 if inside(arc_b.0, arc_a) || inside(arc_a.0, arc_b) {
-                    tied.push((a.shape, b.shape));
+                    tied.push((a.shape, b.shape, unit, [a.a, a.b]));
                 }
             }
         }
     }
+    // A motion that keeps the moved edge in the plane (a translation along
+    // an edge-on face, say) slides it along the tie and crosses no kink,
+    // as `kinks` spares it; the sensor's own motion likewise, axis by axis.
+    let across = |v: glam::DVec3, n: glam::DVec3| v.dot(n).abs() > 1e-9 * v.length();
+    let why = |ka: u32, kb: u32, along: String| {
+        format!(
+            "edges of {} lie in one plane through the sensor and overlap as seen from it: I \
+             may have a kink along {along} (the one-sided derivatives differ) and the \
+             estimate is one of them or neither",
+            if ka == kb {
+                format!("mesh {:?}", scene.shapes()[ka as usize].name)
+            } else {
+                format!(
+                    "meshes {:?} and {:?}",
+                    scene.shapes()[ka as usize].name,
+                    scene.shapes()[kb as usize].name
+                )
+            }
+        )
+    };
     let mut out = Vec::new();
     for (j, p) in params.iter().enumerate() {
         let k = scene.parameter_shape(j);
-        if let Some(&(ka, kb)) = tied.iter().find(|&&(a, _)| a == k) {
+        let crossing = tied.iter().find(|&&(ka, _, n, ends)| {
+            ka == k && ends.iter().any(|&q| across(p.motion.velocity(q), n))
+        });
+        if let Some(&(ka, kb, _, _)) = crossing {
             out.push((
                 Quantity::sensitivity(&p.name),
-                format!(
-                    "edges of {} lie in one plane through the sensor and overlap as seen \
-                     from it: I may have a kink along {:?} (the one-sided derivatives differ) \
-                     and the estimate is one of them or neither",
-                    if ka == kb {
-                        format!("mesh {:?}", scene.shapes()[ka as usize].name)
-                    } else {
-                        format!(
-                            "meshes {:?} and {:?}",
-                            scene.shapes()[ka as usize].name,
-                            scene.shapes()[kb as usize].name
-                        )
-                    },
-                    p.name
-                ),
+                why(ka, kb, format!("{:?}", p.name)),
+            ));
+        }
+    }
+    for (axis, e) in [
+        ("x", glam::DVec3::X),
+        ("y", glam::DVec3::Y),
+        ("z", glam::DVec3::Z),
+    ] {
+        if let Some(&(ka, kb, _, _)) = tied.iter().find(|&&(_, _, n, _)| across(e, n)) {
+            out.push((
+                Quantity::gradient(axis),
+                why(ka, kb, format!("the sensor's {axis}")),
             ));
         }
     }
     out
 }
+
+/// Most ties [`edge_ties`] keeps (a scene of many exactly aligned edges,
+/// a grid seen along its rows, would otherwise keep them all).
+const MAX_TIES: usize = 64;
 
 /// Why the central difference along parameter `j` (half step `h`) may not
 /// estimate the derivative: a face of the moved mesh faces the sensor in
