@@ -225,10 +225,7 @@ fn outruns_lamp(scene: &Scene, j: usize, h: f64) -> Option<String> {
         .iter()
         .filter(|s| matches!(s.surface, crate::path::Surface::Emitter { .. }))
         .find_map(|lamp| {
-            let (lo, hi) = lamp.vertices.iter().fold(
-                (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
-                |(lo, hi), &v| (lo.min(v), hi.max(v)),
-            );
+            let (lo, hi) = super::scene::bounds(&lamp.vertices);
             let centre = 0.5 * (lo + hi);
             let extent = (hi - lo).length() / (centre - x).length();
             (turn >= 0.25 * extent).then(|| {
@@ -330,10 +327,8 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
         };
         let a = &t.edges[i];
         let (ra, rb) = (a.a - x, a.b - x);
-        let n = ra.cross(rb);
-        let (nl, la) = (n.length(), ra.length());
-        let u = ra / la;
-        let angle = |r: glam::DVec3| (n.dot(u.cross(r)) / nl).atan2(u.dot(r));
+        let u = ra / ra.length();
+        let angle = |r: glam::DVec3| unit.dot(u.cross(r)).atan2(u.dot(r));
         // Each edge's arc of sight lines in the plane: a start angle and a
         // length below π (a segment off the sensor subtends less); two arcs
         // overlap when either's start lies strictly inside the other. (As
@@ -362,11 +357,11 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
                 // shadow edge on the other's: rendering 0.0049, finite
                 // differences −0.074, the one-sided −0.148 and 0).
                 let touching = [a.a, a.b].iter().any(|p| *p == b.a || *p == b.b);
-                if (b.shape == a.shape && (k == i || touching)) || tied.len() >= MAX_TIES {
+                if (b.shape == a.shape && touching) || tied.len() >= MAX_TIES {
                     continue;
                 }
                 let (qa, qb) = (b.a - x, b.b - x);
-                let off = |q: glam::DVec3| n.dot(q).abs() <= TIE * nl * q.length();
+                let off = |q: glam::DVec3| unit.dot(q).abs() <= TIE * q.length();
                 if !(off(qa) && off(qb)) {
                     continue;
                 }

@@ -381,13 +381,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                 hooks.interface(g, rng, &leg, x, next);
                 medium = next;
             }
-            // The back of a solid: a sight line through a corner (the
-            // sensor in the plane of a face, say) that rounding carried
-            // inside. The radiance there is irrelevant (nothing outside sees
-            // it); left lit, a closed reflector of albedo 1 kept the path for
-            // the roulette's 10⁵ events (rendering took 10⁴ times the
-            // intensity estimator's time).
-            Surface::Reflector { .. } if g.solid(h.prim) && w.dot(g.normal(h.prim, x)) > 0.0 => {
+            Surface::Reflector { .. } if behind_solid(g, h.prim, x, w) => {
                 hooks.opaque(g, rng, &leg, x, k, drawn);
                 return total;
             }
@@ -422,6 +416,17 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
 }
 // ANCHOR_END: walk
 
+/// Whether a ray along `w` meets primitive `p` at `y` from behind a solid
+/// ([`Geometry::solid`]): a sight line through a corner (the sensor in the
+/// plane of a face, say) that rounding carried inside. The radiance there
+/// is irrelevant (nothing outside sees it), so the back is black; left lit,
+/// a closed reflector of albedo 1 kept the path for the roulette's 10⁵
+/// events (rendering took 10⁴ times the intensity estimator's time).
+#[inline]
+fn behind_solid<G: Geometry>(g: &G, p: Prim, y: G::V, w: G::V) -> bool {
+    g.solid(p) && w.dot(g.normal(p, y)) > 0.0
+}
+
 /// The radiance leaving the surface of primitive `p` at its point `y`
 /// toward a viewer arriving along `w` (in `medium`): one path continued
 /// from that surface event. A corner's jump evaluates each side with it.
@@ -436,8 +441,7 @@ pub fn surface_radiance<G: Geometry>(
     match g.surface(p) {
         Surface::Emitter { radiance } => radiance,
         Surface::Absorber | Surface::Transparent => 0.0,
-        // The back of a solid, as in `walk`.
-        Surface::Reflector { .. } if g.solid(p) && w.dot(g.normal(p, y)) > 0.0 => 0.0,
+        Surface::Reflector { .. } if behind_solid(g, p, y, w) => 0.0,
         Surface::Reflector { albedo } => {
             let lobe = reflector_lobe(g, p, y, w, albedo);
             let v = Vertex {

@@ -23,6 +23,7 @@ mod validate;
 pub use crate::flat::scene::{
     MAX_OFFSET, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE,
 };
+pub(crate) use validate::bounds;
 pub use validate::{DEGENERATE_AREA, TOUCH_DISTANCE};
 
 /// What happens to light arriving at a mesh: the path core's surfaces, read

@@ -256,7 +256,8 @@ pub(super) fn weld(shape: &mut Shape) {
     shape.vertices = vertices;
 }
 
-pub(super) fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
+/// The corners of the vertices' bounding box.
+pub(crate) fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
     vertices
         .iter()
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
