@@ -100,6 +100,23 @@ fn flat(path: &std::path::Path, method: &str, paths: &str) -> Vec<String> {
     ]
 }
 
+/// A sensitivity's mean and standard error in a run's JSON line.
+fn sensitivity_of(out: &str, name: &str) -> (f64, f64) {
+    let v: serde_json::Value = serde_json::from_str(out).unwrap();
+    let s = &v["sensitivity"][name];
+    (s["mean"].as_f64().unwrap(), s["stderr"].as_f64().unwrap())
+}
+
+/// Asserts a reading `(m, sm)` lies within 4 combined standard errors of
+/// expectation's `(e, se)`.
+fn assert_agrees(label: &str, (m, sm): (f64, f64), (e, se): (f64, f64)) {
+    let z = (m - e) / sm.hypot(se);
+    assert!(
+        z.abs() < 4.0,
+        "{label}: {m} ± {sm} against expectation's {e} ± {se}"
+    );
+}
+
 fn run_flat(path: &std::path::Path, method: &str, paths: &str) -> (i32, String, String) {
     let args = flat(path, method, paths);
     geosens(&args.iter().map(String::as_str).collect::<Vec<_>>())
@@ -434,19 +451,12 @@ fn a_closed_lossless_reflector_does_not_trap_the_nested_paths() {
         args.extend(["--threads".into(), "1".into()]);
         let (code, out, err) = geosens(&args.iter().map(String::as_str).collect::<Vec<_>>());
         assert_eq!(code, 0, "{method}: {err}");
-        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-        let s = &v["sensitivity"]["refl0_ty"];
-        (s["mean"].as_f64().unwrap(), s["stderr"].as_f64().unwrap())
+        sensitivity_of(&out, "refl0_ty")
     };
     // The reference: expectation, whose warp draws no corner.
-    let (e, se) = reading("expectation");
+    let e = reading("expectation");
     for method in ["rendering", "transport"] {
-        let (m, sm) = reading(method);
-        let z = (m - e) / sm.hypot(se);
-        assert!(
-            z.abs() < 4.0,
-            "{method}: {m} ± {sm} against expectation's {e} ± {se}"
-        );
+        assert_agrees(method, reading(method), e);
     }
 }
 
@@ -472,21 +482,30 @@ fn a_sight_line_along_a_face_does_not_carry_paths_into_a_solid() {
          surface = { kind = \"reflector\", albedo = 1.0 }\n\
          [[parameters]]\nname = \"box_ty\"\nshape = \"box\"\nmotion = { kind = \"translate_y\" }\n",
     );
-    let corner = |i: usize| [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(|b| b as f64);
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let triangles: Vec<String> = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .map(|t| format!("{t:?}"))
-        .collect();
-    let vertices: Vec<String> = (0..8).map(|i| format!("{:?}", corner(i))).collect();
+    // The unit cube [0, 1]³ as the shipped cases build boxes.
+    let unit_cube = geosens::mesh::cases::box_shape(
+        "box",
+        std::array::from_fn(|i| {
+            glam::DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64)
+        }),
+        geosens::mesh::Surface::Absorber,
+        None,
+    );
+    let rows = |r: Vec<String>| r.join(", ");
+    let vertices = rows(
+        unit_cube
+            .vertices
+            .iter()
+            .map(|v| format!("{:?}", v.to_array()))
+            .collect(),
+    );
+    let triangles = rows(
+        unit_cube
+            .triangles
+            .iter()
+            .map(|t| format!("{t:?}"))
+            .collect(),
+    );
     let mesh_scene = scene_file(
         "solid_mesh.toml",
         &format!(
@@ -499,8 +518,7 @@ fn a_sight_line_along_a_face_does_not_carry_paths_into_a_solid() {
              surface = {{ kind = \"reflector\", albedo = 1.0 }}\n\
              [[parameters]]\nname = \"box_tx\"\nshape = \"box\"\nmotion = {{ kind = \"translate_x\" }}\n\
              [[parameters]]\nname = \"box_tz\"\nshape = \"box\"\nmotion = {{ kind = \"translate_z\" }}\n",
-            vertices.join(", "),
-            triangles.join(", ")
+            vertices, triangles
         ),
     );
     // Each run is 2·10³–10⁴ times shorter than the guard now. The sensor
@@ -529,20 +547,12 @@ fn a_sight_line_along_a_face_does_not_carry_paths_into_a_solid() {
             ];
             let (code, out, err) = geosens(&args);
             assert_eq!(code, 0, "{command} {method}: {err}");
-            let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-            name.map(|n| {
-                let s = &v["sensitivity"][n];
-                (s["mean"].as_f64().unwrap(), s["stderr"].as_f64().unwrap())
-            })
+            name.map(|n| sensitivity_of(&out, n))
         };
         let e = reading("expectation");
         for method in ["rendering", "transport"] {
-            if let (Some((m, sm)), Some((e, se))) = (reading(method), e) {
-                let z = (m - e) / sm.hypot(se);
-                assert!(
-                    z.abs() < 4.0,
-                    "{command} {method}: {m} ± {sm} against expectation's {e} ± {se}"
-                );
+            if let (Some(m), Some(e)) = (reading(method), e) {
+                assert_agrees(&format!("{command} {method}"), m, e);
             }
         }
     }

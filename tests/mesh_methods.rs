@@ -25,6 +25,19 @@ fn square_irradiance(a: f64, h: f64) -> f64 {
     4.0 * (x / s * (x / s).atan())
 }
 
+/// Each derivative method's caveats on `scene`.
+fn caveats_by_method(scene: &Arc<Scene>) -> Vec<(Method, Vec<(Quantity, String)>)> {
+    [
+        Method::Rendering,
+        Method::Transport,
+        Method::Expectation,
+        Method::Fd,
+    ]
+    .into_iter()
+    .map(|m| (m, m.estimator(Arc::clone(scene)).unwrap().caveats()))
+    .collect()
+}
+
 fn estimate(scene: &Arc<Scene>, m: Method, n: u64, seed: u64) -> geosens::RunResult {
     let e = m.estimator(Arc::clone(scene)).unwrap();
     run(e.as_ref(), &RunConfig::new(n, seed).unwrap()).unwrap()
@@ -1253,13 +1266,7 @@ fn edges_of_one_mesh_aligned_from_the_sensor_are_a_caveat_too() {
     for (dx, tied) in [(0.0, true), (1e-6, false)] {
         let parameters = params("pair", &[("tx", Motion::TranslateX)]);
         let scene = Arc::new(Scene::new(vec![lamp(), pair(dx)], parameters, up()).unwrap());
-        for m in [
-            Method::Rendering,
-            Method::Transport,
-            Method::Expectation,
-            Method::Fd,
-        ] {
-            let caveats = m.estimator(Arc::clone(&scene)).unwrap().caveats();
+        for (m, caveats) in caveats_by_method(&scene) {
             let on = |q: &Quantity| {
                 caveats
                     .iter()
@@ -1306,13 +1313,7 @@ fn edges_of_one_mesh_aligned_from_the_sensor_are_a_caveat_too() {
         &[("tx", Motion::TranslateX), ("tz", Motion::TranslateZ)],
     );
     let scene = Arc::new(Scene::new(vec![lamp(), face_on], parameters, up()).unwrap());
-    for m in [
-        Method::Rendering,
-        Method::Transport,
-        Method::Expectation,
-        Method::Fd,
-    ] {
-        let caveats = m.estimator(Arc::clone(&scene)).unwrap().caveats();
+    for (m, caveats) in caveats_by_method(&scene) {
         let on = |name: &str| {
             caveats
                 .iter()

@@ -324,12 +324,19 @@ fn states_that_are_not_one_whole_run_are_refused() {
         err.contains("method expectation against intensity"),
         "{err}"
     );
+    // The state file `from` with `edit` applied, written as `name`.
+    let edited = |from: &str, name: &str, edit: &dyn Fn(&mut Value)| {
+        let mut v: Value = serde_json::from_str(&std::fs::read_to_string(from).unwrap()).unwrap();
+        edit(&mut v);
+        let path = dir.join(name);
+        std::fs::write(&path, v.to_string()).unwrap();
+        path.to_str().unwrap().to_owned()
+    };
     // A damaged state: a block dropped.
-    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(s2).unwrap()).unwrap();
-    v["payload"]["moments"].as_array_mut().unwrap().pop();
-    let damaged = dir.join("damaged.json");
-    std::fs::write(&damaged, v.to_string()).unwrap();
-    let err = refused(&["merge", s1, damaged.to_str().unwrap(), s3]);
+    let damaged = edited(s2, "damaged.json", &|v| {
+        v["payload"]["moments"].as_array_mut().unwrap().pop();
+    });
+    let err = refused(&["merge", s1, &damaged, s3]);
     assert!(
         err.contains("should hold blocks") && err.contains("damaged"),
         "{err}"
@@ -344,31 +351,26 @@ fn states_that_are_not_one_whole_run_are_refused() {
         err.contains("cut.json") && err.contains("cut short"),
         "{err}"
     );
-    let mut v: Value = serde_json::from_str(&text).unwrap();
-    v["seconds"] = Value::from(-1.0);
-    let slow = dir.join("slow.json");
-    std::fs::write(&slow, v.to_string()).unwrap();
-    let err = refused(&["merge", s1, slow.to_str().unwrap(), s3]);
+    let slow = edited(s2, "slow.json", &|v| v["seconds"] = Value::from(-1.0));
+    let err = refused(&["merge", s1, &slow, s3]);
     assert!(
         err.contains("damaged") && err.contains("time is -1"),
         "{err}"
     );
-    let mut v: Value = serde_json::from_str(&text).unwrap();
-    let n = v["payload"]["moments"][0][0][0].as_u64().unwrap();
-    v["payload"]["moments"][0][0][1] = Value::from(n + 5);
-    let many = dir.join("many.json");
-    std::fs::write(&many, v.to_string()).unwrap();
-    let err = refused(&["merge", s1, many.to_str().unwrap(), s3]);
+    let many = edited(s2, "many.json", &|v| {
+        let n = v["payload"]["moments"][0][0][0].as_u64().unwrap();
+        v["payload"]["moments"][0][0][1] = Value::from(n + 5);
+    });
+    let err = refused(&["merge", s1, &many, s3]);
     assert!(
         err.contains("damaged") && err.contains("non-zero weights among"),
         "{err}"
     );
     // A shard count no run has (it would allocate a slot per shard).
-    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(s1).unwrap()).unwrap();
-    v["run"]["shards"] = Value::from(u64::MAX);
-    let huge = dir.join("huge.json");
-    std::fs::write(&huge, v.to_string()).unwrap();
-    let err = refused(&["merge", huge.to_str().unwrap()]);
+    let huge = edited(s1, "huge.json", &|v| {
+        v["run"]["shards"] = Value::from(u64::MAX)
+    });
+    let err = refused(&["merge", &huge]);
     assert!(err.contains("huge.json") && err.contains("I/N"), "{err}");
     // Not a state at all, and no file.
     let err = refused(&["merge", &occluder]);
