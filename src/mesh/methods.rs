@@ -188,7 +188,9 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
             half_step: h,
         });
     }
-    let ties = edge_ties(&Space::new(Arc::clone(scene)));
+    // The nominal scene's geometry serves the ties and then the nominal run.
+    let nominal = Space::new(Arc::clone(scene));
+    let ties = edge_ties(&nominal);
     for (q, why) in kinks(scene).into_iter().chain(ties) {
         if let Quantity::Sensitivity(name) = q
             && !caveats.iter().any(|c: &(String, String)| c.0 == name)
@@ -196,8 +198,8 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
             caveats.push((name, why));
         }
     }
-    let mut fd =
-        CentralDifference::new(Some(Method::Intensity.estimator(Arc::clone(scene))?), pairs)?;
+    let nominal: Box<dyn Estimator> = Box::new(IntensityEstimator { geometry: nominal });
+    let mut fd = CentralDifference::new(Some(nominal), pairs)?;
     for (parameter, why) in caveats {
         fd = fd.with_caveat(&parameter, why);
     }
