@@ -123,6 +123,20 @@ fn bad_obj_files_are_named() {
     let path = scene_with("malformed", OCC, &[("occ.obj", "v 0 0 zero\nf 1 2 3\n")]);
     let e = err_of(file::load(&path));
     assert!(e.contains("occ.obj") && e.contains("malformed OBJ"), "{e}");
+    assert!(e.contains("line 1: a vertex needs 3 numbers"), "{e}");
+    // The line at fault in a longer file, and a face that would have been
+    // dropped (tobj keeps two corners as a line).
+    let long = "# a quad\nv 0 0 1\nv 0.2 0 1\nv 0.2 0.2 1\nv 0 0.2 1\nf 1 2 3 4\nf 1 3 5\n";
+    let path = scene_with("index", OCC, &[("occ.obj", long)]);
+    let e = err_of(file::load(&path));
+    assert!(
+        e.contains("line 7: a vertex index is out of range: `f 1 3 5`"),
+        "{e}"
+    );
+    let short = "v 0 0 1\nv 0.2 0 1\nv 0.2 0.2 1\nf 1 2 3\nf 1 2\n";
+    let path = scene_with("short", OCC, &[("occ.obj", short)]);
+    let e = err_of(file::load(&path));
+    assert!(e.contains("line 5: a face needs 3 or more vertices"), "{e}");
     let path = scene_with("empty", OCC, &[("occ.obj", "# nothing\n")]);
     let e = err_of(file::load(&path));
     assert!(e.contains("\"occ\" has no triangles"), "{e}");

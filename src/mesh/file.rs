@@ -235,11 +235,19 @@ fn read_obj(path: &Path, name: &str) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), Erro
         ignore_lines: true,
         ..Default::default()
     };
+    let text = String::from_utf8_lossy(&bytes);
+    let at_line = |(line, why): (usize, String)| fail(format!("malformed OBJ, line {line}: {why}"));
+    if let Some(short) = super::obj_lines::short_face(&text) {
+        return Err(at_line(short));
+    }
     // Materials are not read: a `mtllib` line loads nothing.
     let (models, _) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| fail(format!("malformed OBJ ({e})")))?;
+    .map_err(|e| match super::obj_lines::locate(&text) {
+        Some(found) => at_line(found),
+        None => fail(format!("malformed OBJ ({e})")),
+    })?;
     let mut vertices = Vec::new();
     let mut triangles = Vec::new();
     for m in &models {

@@ -27,6 +27,7 @@ pub mod file;
 pub mod knots;
 pub mod lobe;
 pub mod methods;
+mod obj_lines;
 pub mod scene;
 pub mod sensor_view;
 pub mod space;
