@@ -93,3 +93,112 @@ fn scenes_beyond_the_supported_sizes_are_refused_by_name() {
         assert!(e.contains("size") && e.contains("rescale"), "{e}");
     }
 }
+
+/// An edge-on lamp (its ends 3·10⁻⁷ rad apart as seen from the sensor)
+/// rotating about its near end, the sensor inside an absorbing pentagon,
+/// 480 sizes from the origin (found by a random-scene campaign). The ray
+/// aimed at the lamp's far end grazes the lamp and met it, by rounding,
+/// ~10⁻⁷ short of the end: the corner was "hidden", rendering and transport
+/// read 0 (0.11 with a reflector beside it: wrong and marked reliable).
+/// Every method against the closed form, there and at the origin.
+#[test]
+fn an_edge_on_lamp_far_from_the_origin_keeps_its_corner() {
+    let scene_at = |o: [f64; 2]| {
+        let p = |x: f64, y: f64| format!("[{:?}, {:?}]", x - o[0], y - o[1]);
+        let text = format!(
+            r#"
+[sensor]
+kind = "irradiance"
+point = {s}
+normal = [-0.305211882058486, 0.9522844675044936]
+
+[[shapes]]
+name = "lamp"
+vertices = [{l0}, {l1}]
+surface = {{ kind = "emitter", radiance = 0.78 }}
+
+[[shapes]]
+name = "room"
+vertices = [{r0}, {r1}, {r2}, {r3}, {r4}]
+closed = true
+surface = {{ kind = "transparent" }}
+medium = {{ ks = 0.0, ke = 0.563 }}
+
+[[parameters]]
+name = "lamp_rotate"
+shape = "lamp"
+motion = {{ kind = "rotate", pivot = {l0} }}
+"#,
+            s = p(-476.86888153604, 878.9744420758582),
+            l0 = p(-477.0725701911312, 880.4958390434773),
+            l1 = p(-477.1714772522132, 881.2345927980987),
+            r0 = p(-475.16003642226644, 879.4001318601527),
+            r1 = p(-477.3458392214908, 880.5126357693001),
+            r2 = p(-478.4459129677018, 878.4580961919189),
+            r3 = p(-476.98490184599007, 877.1962338095426),
+            r4 = p(-475.3662418481978, 877.9535487197684),
+        );
+        Arc::new(file::from_toml(&text).unwrap())
+    };
+    let origin = [-476.86888153604, 878.9744420758582];
+    let exact = Reference::for_scene(&scene_at(origin))
+        .unwrap()
+        .derivative(0);
+    assert!(exact > 0.1, "{exact}");
+    for o in [origin, [0.0, 0.0]] {
+        let scene = scene_at(o);
+        for method in [Method::Rendering, Method::Expectation, Method::Transport] {
+            let e = method.estimator(scene.clone()).unwrap();
+            let r = run(e.as_ref(), &RunConfig::new(100_000, 2).unwrap()).unwrap();
+            let s = r.get(&Quantity::sensitivity("lamp_rotate")).unwrap();
+            assert!(
+                s.z_score(exact) < 4.0 && s.is_reliable(),
+                "{} at {o:?}: {s:?} vs {exact}",
+                method.name()
+            );
+        }
+    }
+}
+
+/// A lamp exactly on a sight line from the sensor, its coordinates not
+/// round (campaign): its far end is hidden behind the near one, a tie
+/// whose derivative is a kink (±47.7 one-sided). The tie test took the
+/// near end as hidden by the lamp itself (the grazing rounding above), so
+/// no caveat was printed and rendering reported 234 ± 0.4, reliable.
+#[test]
+fn a_lamp_on_a_sight_line_with_unround_coordinates_is_a_caveat() {
+    let text = r#"
+[sensor]
+kind = "irradiance"
+point = [0.009926716869978616, 0.001208425497613291]
+normal = [-0.7393989077337133, 0.6732675955682048]
+
+[[shapes]]
+name = "lamp0"
+vertices = [[0.008619761004118829, 0.0015190527994969302], [0.00835255769936419, 0.001582559642978384]]
+surface = { kind = "emitter", radiance = 1.867 }
+
+[[parameters]]
+name = "lamp0_translate_x"
+shape = "lamp0"
+motion = { kind = "translate_x" }
+"#;
+    let scene = Arc::new(file::from_toml(text).unwrap());
+    for method in [
+        Method::Rendering,
+        Method::Expectation,
+        Method::Transport,
+        Method::Fd,
+    ] {
+        let e = method.estimator(scene.clone()).unwrap();
+        let caveats = e.caveats();
+        assert!(
+            caveats
+                .iter()
+                .any(|(q, why)| *q == Quantity::sensitivity("lamp0_translate_x")
+                    && (method == Method::Fd || why.contains("one sight line"))),
+            "{}: {caveats:?}",
+            method.name()
+        );
+    }
+}

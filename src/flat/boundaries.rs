@@ -180,6 +180,10 @@ impl Boundaries for Plane {
 
     // ANCHOR_END: sides
     #[inline]
+    fn holds(&self, b: &BoundaryPoint<DVec2>, p: u32) -> bool {
+        self.corner_segments[b.index as usize].contains(&p)
+    }
+    #[inline]
     fn boundary_normal(&self, x: DVec2, b: &BoundaryPoint<DVec2>) -> DVec2 {
         perp((b.q - x).normalize())
     }
@@ -319,7 +323,7 @@ impl Plane {
                 if i == usize::MAX {
                     *done = true;
                     None
-                } else if scene.visible(x, corners[i].0, skip) {
+                } else if scene.sees_corner(x, i, skip) {
                     *done = true;
                     Some(i)
                 } else {

@@ -148,7 +148,7 @@ pub fn ties(scene: &Scene) -> Vec<(Quantity, String)> {
         for b in ahead[i + 1..].iter().take_while(|b| b.0 - a.0 <= TIE) {
             let near = if a.1 <= b.1 { a.2 } else { b.2 };
             let (ka, kb) = (corners[a.2].1, corners[b.2].1);
-            if scene.visible(point, corners[near].0, super::geometry::NO_SEGMENT) {
+            if scene.sees_corner(point, near, super::geometry::NO_SEGMENT) {
                 tied.push((ka, kb));
             }
         }

@@ -268,10 +268,9 @@ pub(super) fn sensor_corners(scene: &Scene) -> Vec<(f64, usize)> {
     let Some((point, ahead)) = corners_ahead(scene) else {
         return Vec::new();
     };
-    let corners = scene.corners();
     ahead
         .into_iter()
-        .filter(|&(_, _, i)| scene.visible(point, corners[i].0, NO_SEGMENT))
+        .filter(|&(_, _, i)| scene.sees_corner(point, i, NO_SEGMENT))
         .map(|(angle, _, i)| (angle, i))
         .collect()
 }

@@ -889,6 +889,12 @@ impl Boundaries for Space {
         (ahead.1, behind.1)
     }
     // ANCHOR_END: sides
+    #[inline]
+    fn holds(&self, b: &BoundaryPoint<DVec3>, p: Prim) -> bool {
+        self.edge_tables().edges[b.index as usize]
+            .faces
+            .contains(&p)
+    }
 
     /// `η × ê / |η × ê|`: normal to the edge's arc on the sphere at `η`.
     #[inline]

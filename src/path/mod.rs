@@ -433,6 +433,13 @@ pub trait Boundaries: Geometry {
     /// [`Boundaries::boundary_normal`] points to (plane: counter-clockwise),
     /// then the other.
     fn sides(&self, x: Self::V, b: &BoundaryPoint<Self::V>) -> (Side, Side);
+    /// Whether primitive `p` holds the boundary point (plane: a segment
+    /// ending at the corner; 3D: a face along the edge). A ray aimed at the
+    /// point meets such a primitive only there, so a hit on it short of the
+    /// point is rounding: a grazing ray finds it up to ~ε·|q|/γ early (γ
+    /// the angle between them), which 500 sizes from the origin hid an
+    /// edge-on lamp's far end from every corner term.
+    fn holds(&self, b: &BoundaryPoint<Self::V>, p: Prim) -> bool;
     /// The unit vector tangent to the directions at `η_q` (the direction
     /// from `x` to the boundary point), normal to the boundary there and
     /// pointing to the side [`Boundaries::sides`] names first.

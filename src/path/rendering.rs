@@ -211,7 +211,7 @@ fn corner_term<G: Boundaries>(
     if v.skip != NO_PRIM && g.normal(v.skip, v.x).dot(wq).abs() <= EDGE_ON {
         return;
     }
-    let Some((t, medium)) = reach(g, v.x, b.q, v.medium, v.skip) else {
+    let Some((t, medium)) = reach(g, v.x, b.q, v.medium, v.skip, |p| g.holds(b, p)) else {
         return;
     };
     let normal = g.boundary_normal(v.x, b);

@@ -551,23 +551,32 @@ pub fn reach<G: Geometry>(
     q: G::V,
     mut medium: MediumId,
     mut skip: Prim,
+    holds: impl Fn(Prim) -> bool,
 ) -> Option<(f64, MediumId)> {
     let d = q - x;
     let mut left = d.length();
     let w = d * (1.0 / left);
     let mut tau = 0.0;
+    // Hits on primitives that hold q pass (a few: they meet the sight line
+    // only at q, so a hit short of it is rounding; see `Boundaries::holds`).
+    let mut passes = 0;
     loop {
         let ke = g.coefficients(medium).map_or(0.0, |c| c.1);
         match g.cast(x, w, skip) {
             Some(h) if h.t < left * (1.0 - 1e-9) => {
-                if g.surface(h.prim) != Surface::Transparent {
+                let opaque = g.surface(h.prim) != Surface::Transparent;
+                if opaque && !(passes < 4 && holds(h.prim)) {
                     return None;
                 }
                 tau += ke * h.t;
                 left -= h.t;
                 x = x + w * h.t;
                 skip = h.prim;
-                medium = g.crossed(medium, g.shape(h.prim));
+                if opaque {
+                    passes += 1;
+                } else {
+                    medium = g.crossed(medium, g.shape(h.prim));
+                }
             }
             _ => return Some(((-(tau + ke * left)).exp(), medium)),
         }

@@ -358,6 +358,38 @@ impl Scene {
         };
         !self.opaque.any_hit(from, d / len, len * (1.0 - 1e-9), skip)
     }
+    /// Whether corner `i` is seen from `from`: [`Self::visible`], except
+    /// that the corner's own segments do not hide it. A ray aimed at a
+    /// corner meets them only there, but a grazing one (an edge-on lamp's
+    /// far end) finds them up to ~ε·|q|/γ short of it by rounding, which
+    /// 500 sizes from the origin hid the corner (`path::Boundaries::holds`
+    /// is the nested paths' twin).
+    pub fn sees_corner(&self, from: DVec2, i: usize, skip: u32) -> bool {
+        let q = self.corners[i].0;
+        if self.visible(from, q, skip) {
+            return true;
+        }
+        let d = q - from;
+        let len = d.length();
+        let w = d / len;
+        let (mut x, mut left, mut skip, mut passes) = (from, len, skip, 0);
+        loop {
+            match self.cast(x, w, skip) {
+                Some(h) if h.t < left * (1.0 - 1e-9) => {
+                    let seg = self.segments[h.segment as usize];
+                    let own = seg.a == q || seg.b == q;
+                    if self.shape_of(h.segment).surface.is_opaque() && !(own && passes < 4) {
+                        return false;
+                    }
+                    passes += own as u32;
+                    x += w * h.t;
+                    left -= h.t;
+                    skip = h.segment;
+                }
+                _ => return true,
+            }
+        }
+    }
     /// The first opaque segment along a ray (not `skip`): distance, the
     /// segment and its shape.
     #[inline]
