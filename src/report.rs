@@ -201,10 +201,19 @@ impl Report {
             .find(|(_, e)| !(e.mean.is_finite() && e.stderr.is_finite()))
         {
             Some((q, e)) => Err(Error::Output(format!(
-                "method {} gives {q} = {} ± {} at these inputs (floating-point overflow)",
+                "method {} gives {q} = {} ± {} at these inputs ({})",
                 self.result.method,
                 Num(e.mean),
-                Num(e.stderr)
+                Num(e.stderr),
+                // `Moments::lost_to_underflow`: the mean is fine, its error
+                // bar is not.
+                if e.mean.is_finite() && e.mean.abs() < 1e-100 {
+                    "floating-point underflow: the weights' squared deviations fall below the \
+                     smallest double, so the error bar cannot be computed in double precision \
+                     (a scene: scale the emitters' radiance up; the answers scale with it)"
+                } else {
+                    "floating-point overflow"
+                }
             ))),
             None => Ok(()),
         }
