@@ -197,6 +197,8 @@ fn bad_requests_are_refused_with_a_message() {
     let text = std::fs::read_to_string(&camera).unwrap();
     for (from, to, says) in [
         ("fov_deg = 90.0", "fov_deg = 180.0", "fov_deg"),
+        // Pixels so narrow that their directions round to one another.
+        ("fov_deg = 90.0", "fov_deg = 1e-13", "a pixel spans"),
         ("width = 32", "width = 0", "width"),
         ("up = [0.0, 1.0, 0.0]", "up = [0.0, 0.0, 1.0]", "up"),
         ("width = 32", "width = 32\nzoom = 2", "zoom"),
