@@ -429,7 +429,8 @@ struct RenderJsonLine<'a> {
 
 impl ImageReport {
     /// The warnings `geosens render` prints on stderr: one per caveat, one
-    /// per image with a pixel that is not finite.
+    /// per image with a pixel that is not finite, one per image with a
+    /// pixel the EXR files' 32-bit floats cannot hold.
     pub fn warnings(&self) -> Vec<String> {
         let mut w: Vec<String> = self
             .caveats
@@ -443,6 +444,22 @@ impl ImageReport {
             {
                 w.push(format!(
                     "warning: {q}: some pixels are not finite (overflow)"
+                ));
+            }
+            // The EXR files hold 32-bit floats (the .npy files doubles).
+            let beyond_f32 = |x: f64| {
+                x.is_finite()
+                    && x != 0.0
+                    && !(f64::from(f32::MIN_POSITIVE)..=f64::from(f32::MAX)).contains(&x.abs())
+            };
+            if img
+                .iter()
+                .any(|e| beyond_f32(e.mean) || beyond_f32(e.stderr))
+            {
+                w.push(format!(
+                    "warning: {q}: some pixels lie outside the 32-bit range of the EXR files \
+                     (below 1.2e-38 they lose digits or read 0, above 3.4e38 they read inf); \
+                     the .npy files keep them as doubles"
                 ));
             }
         }

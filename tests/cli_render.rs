@@ -269,3 +269,41 @@ fn flatland_line_cameras_render_a_row() {
     assert_eq!(shape, vec![1, 40]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Pixels the EXR files' 32-bit floats cannot hold are said on stderr (a
+/// lamp of radiance 10⁻⁴⁵ wrote EXR images of zeros without a word); the
+/// .npy files keep the doubles.
+#[test]
+fn pixels_beyond_the_exr_range_are_a_warning() {
+    let text = std::fs::read_to_string(scene("camera_shadow.toml")).unwrap();
+    assert!(text.contains("radiance = 1.0"));
+    let dir = scratch("exr-range");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("faint.toml");
+    std::fs::write(&path, text.replace("radiance = 1.0", "radiance = 1e-45")).unwrap();
+    let out = dir.join("out");
+    let args = [
+        "render",
+        "--scene",
+        path.to_str().unwrap(),
+        "--method",
+        "rendering",
+        "--spp",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let o = geosens(&args);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("32-bit range of the EXR files"), "{stderr}");
+    let (_, intensity) = npy(&out.join("I.npy"));
+    assert!(intensity.iter().any(|&x| x > 0.0 && x < 1e-40));
+    // At radiance 1 no such warning.
+    let plain = scene("camera_shadow.toml");
+    let mut args = args;
+    args[2] = &plain;
+    let o = geosens(&args);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("32-bit"), "{stderr}");
+}
