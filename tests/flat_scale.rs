@@ -202,3 +202,59 @@ motion = { kind = "translate_x" }
         );
     }
 }
+
+/// A lamp 4·10⁻¹² rad from edge-on, 10⁸ from the origin (campaign): the
+/// angles of its ends carry ~5·10⁻¹⁰ rad of rounding there, so the two
+/// cannot be told apart, yet the tie test (10⁻¹² rad) passed it and
+/// expectation read −0.0015 against rendering's 0.0433, both "reliable".
+/// The tie's tolerance now grows with the coordinates' rounding.
+#[test]
+fn an_edge_on_lamp_far_out_is_a_tie_within_its_rounding() {
+    let text = r#"{"sensor": {"kind": "irradiance", "point": [-75887305.78481811, 65123857.538704745], "normal": [-0.42254594313287286, -0.9063415062447218]},
+ "shapes": [{"name": "lamp0", "vertices": [[-75887251.8604876, 65121007.04355613], [-75887238.15108676, 65120282.350636]], "surface": {"kind": "emitter", "radiance": 0.56}}],
+ "parameters": [{"name": "lamp0_rotate", "shape": "lamp0", "motion": {"kind": "rotate", "pivot": [-75887251.8604876, 65121007.04355613]}}]}"#;
+    let scene = Arc::new(file::from_json(text).unwrap());
+    let caveats = geosens::flat::methods::ties(&scene);
+    assert!(
+        caveats
+            .iter()
+            .any(|(q, why)| *q == Quantity::sensitivity("lamp0_rotate")
+                && why.contains("one sight line")),
+        "{caveats:?}"
+    );
+    // The shipped occluder scene 10⁵ from the origin (within the
+    // supported offset) keeps no tie.
+    let base = scaled(1.0).unwrap();
+    let d = glam::DVec2::new(-8e4, 6e4);
+    let mut shapes = base.shapes().to_vec();
+    for s in &mut shapes {
+        for v in &mut s.vertices {
+            *v += d;
+        }
+    }
+    let sensor = match base.sensor() {
+        Sensor::Irradiance { point, normal } => Sensor::Irradiance {
+            point: point + d,
+            normal,
+        },
+        s => s,
+    };
+    let parameters = base
+        .parameters()
+        .iter()
+        .map(|p| Parameter {
+            motion: match p.motion {
+                Motion::Rotate { pivot } => Motion::Rotate {
+                    pivot: pivot.map(|c| c + d),
+                },
+                Motion::Scale { pivot } => Motion::Scale {
+                    pivot: pivot.map(|c| c + d),
+                },
+                m => m,
+            },
+            ..p.clone()
+        })
+        .collect();
+    let far = Scene::new(shapes, parameters, sensor).unwrap();
+    assert!(geosens::flat::methods::ties(&far).is_empty());
+}
