@@ -213,13 +213,33 @@ impl Boundaries for Plane {
         }
     }
 
+    /// A point on segment `p` a hair from the corner: 10⁻⁹ of the scene's
+    /// size, or further where the corner is sharp and far from the origin.
+    /// The point must stay on its side of the corner's other segment,
+    /// `step · sin θ` away across an acute angle θ, by more than the
+    /// rounding of its coordinates: a reflecting sliver (θ ~ 10⁻⁴) 10⁵
+    /// from the origin had its nested paths start across the other face,
+    /// and rendering and transport read half the derivative, "reliable"
+    /// (campaign).
     #[inline]
     fn off_boundary(&self, b: &BoundaryPoint<DVec2>, p: u32) -> DVec2 {
-        let seg = self.scene.segments()[p as usize];
-        let other = far_end(&seg, b.q);
-        let along = other - b.q;
-        let step = (1e-9 * self.scene.size()).min(0.5 * along.length());
-        b.q + along.normalize() * step
+        let segments = self.scene.segments();
+        let seg = segments[p as usize];
+        let along = (far_end(&seg, b.q) - b.q).normalize();
+        let mut sin = 1.0f64;
+        for s in self.corner_segments[b.index as usize] {
+            if s != p && s != NO_SEGMENT {
+                let next = (far_end(&segments[s as usize], b.q) - b.q).normalize();
+                if along.dot(next) > 0.0 {
+                    sin = sin.min(cross(along, next).abs());
+                }
+            }
+        }
+        let rounding = 16.0 * f64::EPSILON * b.q.abs().max_element();
+        let step = (1e-9 * self.scene.size())
+            .max(rounding / sin.max(f64::MIN_POSITIVE))
+            .min(0.5 * seg.length());
+        b.q + along * step
     }
 
     // ANCHOR: warp_velocity
