@@ -44,6 +44,40 @@ fn scaled(factor: f64) -> Result<Scene, geosens::Error> {
     Scene::new(shapes, parameters, sensor)
 }
 
+/// `base` moved by `d`: every vertex, the sensor and every pivot.
+fn shifted(base: &Scene, d: glam::DVec2) -> Result<Scene, geosens::Error> {
+    let mut shapes = base.shapes().to_vec();
+    for s in &mut shapes {
+        for v in &mut s.vertices {
+            *v += d;
+        }
+    }
+    let parameters = base
+        .parameters()
+        .iter()
+        .map(|p| Parameter {
+            motion: match p.motion {
+                Motion::Rotate { pivot } => Motion::Rotate {
+                    pivot: pivot.map(|c| c + d),
+                },
+                Motion::Scale { pivot } => Motion::Scale {
+                    pivot: pivot.map(|c| c + d),
+                },
+                m => m,
+            },
+            ..p.clone()
+        })
+        .collect();
+    let sensor = match base.sensor() {
+        Sensor::Irradiance { point, normal } => Sensor::Irradiance {
+            point: point + d,
+            normal,
+        },
+        s => s,
+    };
+    Scene::new(shapes, parameters, sensor)
+}
+
 #[test]
 fn every_method_works_at_every_accepted_scale() {
     let unit = Reference::for_scene(&scaled(1.0).unwrap()).unwrap();
@@ -224,38 +258,7 @@ fn an_edge_on_lamp_far_out_is_a_tie_within_its_rounding() {
     );
     // The shipped occluder scene 10⁵ from the origin (within the
     // supported offset) keeps no tie.
-    let base = scaled(1.0).unwrap();
-    let d = glam::DVec2::new(-8e4, 6e4);
-    let mut shapes = base.shapes().to_vec();
-    for s in &mut shapes {
-        for v in &mut s.vertices {
-            *v += d;
-        }
-    }
-    let sensor = match base.sensor() {
-        Sensor::Irradiance { point, normal } => Sensor::Irradiance {
-            point: point + d,
-            normal,
-        },
-        s => s,
-    };
-    let parameters = base
-        .parameters()
-        .iter()
-        .map(|p| Parameter {
-            motion: match p.motion {
-                Motion::Rotate { pivot } => Motion::Rotate {
-                    pivot: pivot.map(|c| c + d),
-                },
-                Motion::Scale { pivot } => Motion::Scale {
-                    pivot: pivot.map(|c| c + d),
-                },
-                m => m,
-            },
-            ..p.clone()
-        })
-        .collect();
-    let far = Scene::new(shapes, parameters, sensor).unwrap();
+    let far = shifted(&scaled(1.0).unwrap(), glam::DVec2::new(-8e4, 6e4)).unwrap();
     assert!(geosens::flat::methods::ties(&far).is_empty());
 }
 
@@ -269,26 +272,11 @@ fn an_edge_on_lamp_far_out_is_a_tie_within_its_rounding() {
 fn a_sharp_reflecting_corner_far_out_keeps_its_corner_term() {
     let text = r#"{"sensor": {"kind": "irradiance", "point": [-57909.023983268904, -81526.34507510555], "normal": [-0.4868922763733052, -0.8734620261969155]}, "shapes": [{"name": "lamp0", "vertices": [[-57912.30068554195, -81526.59364277095], [-57910.59722609934, -81525.71007874192]], "surface": {"kind": "emitter", "radiance": 1.228}}, {"name": "lamp1", "vertices": [[-57909.86821651675, -81527.23370538071], [-57909.5499046855, -81526.71603653954]], "surface": {"kind": "emitter", "radiance": 1.898}}, {"name": "o0", "vertices": [[-57909.1328040033, -81527.0383361286], [-57908.7579048943, -81526.75655676471], [-57908.635652140176, -81526.34911494979]], "surface": {"kind": "absorber"}}, {"name": "o1", "vertices": [[-57910.10933807514, -81525.80277040825], [-57910.08443996384, -81526.506446327], [-57910.09685383569, -81526.15460712272]], "closed": true, "surface": {"kind": "reflector", "albedo": 0.495}}, {"name": "o2", "vertices": [[-57910.4201865064, -81527.78917755434], [-57910.701903802226, -81527.47027705132]], "surface": {"kind": "reflector", "albedo": 0.797}}], "parameters": [{"name": "o0_rotate", "shape": "o0", "motion": {"kind": "rotate"}}, {"name": "o0_translate_y", "shape": "o0", "motion": {"kind": "translate_y"}}, {"name": "o1_translate_y", "shape": "o1", "motion": {"kind": "translate_y"}}]}"#;
     let far = Arc::new(file::from_json(text).unwrap());
-    let near = {
-        let d = -match far.sensor() {
-            Sensor::Irradiance { point, .. } => point,
-            _ => unreachable!(),
-        };
-        let mut shapes = far.shapes().to_vec();
-        for s in &mut shapes {
-            for v in &mut s.vertices {
-                *v += d;
-            }
-        }
-        let sensor = match far.sensor() {
-            Sensor::Irradiance { normal, .. } => Sensor::Irradiance {
-                point: glam::DVec2::ZERO,
-                normal,
-            },
-            _ => unreachable!(),
-        };
-        Arc::new(Scene::new(shapes, far.parameters().to_vec(), sensor).unwrap())
+    let to_origin = -match far.sensor() {
+        Sensor::Irradiance { point, .. } => point,
+        _ => unreachable!(),
     };
+    let near = Arc::new(shifted(&far, to_origin).unwrap());
     let q = Quantity::sensitivity("o1_translate_y");
     let estimate = |scene: &Arc<Scene>, method: Method| {
         let e = method.estimator(scene.clone()).unwrap();
