@@ -9,47 +9,25 @@ use geosens::{Quantity, RunConfig, run};
 use std::path::Path;
 use std::sync::Arc;
 
+/// The shipped occluder scene scaled about the origin by `factor`.
 fn scaled(factor: f64) -> Result<Scene, geosens::Error> {
     let base =
         file::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/occluder.toml")).unwrap();
-    let mut shapes = base.shapes().to_vec();
-    for s in &mut shapes {
-        for v in &mut s.vertices {
-            *v *= factor;
-        }
-    }
-    let parameters = base
-        .parameters()
-        .iter()
-        .map(|p| Parameter {
-            motion: match p.motion {
-                Motion::Rotate { pivot } => Motion::Rotate {
-                    pivot: pivot.map(|c| c * factor),
-                },
-                Motion::Scale { pivot } => Motion::Scale {
-                    pivot: pivot.map(|c| c * factor),
-                },
-                m => m,
-            },
-            ..p.clone()
-        })
-        .collect();
-    let sensor = match base.sensor() {
-        Sensor::Irradiance { point, normal } => Sensor::Irradiance {
-            point: point * factor,
-            normal,
-        },
-        s => s,
-    };
-    Scene::new(shapes, parameters, sensor)
+    mapped(&base, |v| v * factor)
 }
 
-/// `base` moved by `d`: every vertex, the sensor and every pivot.
+/// `base` moved by `d`.
 fn shifted(base: &Scene, d: glam::DVec2) -> Result<Scene, geosens::Error> {
+    mapped(base, |v| v + d)
+}
+
+/// `base` with every point (vertex, sensor, pivot) mapped by `f`, a
+/// similarity that keeps directions.
+fn mapped(base: &Scene, f: impl Fn(glam::DVec2) -> glam::DVec2) -> Result<Scene, geosens::Error> {
     let mut shapes = base.shapes().to_vec();
     for s in &mut shapes {
         for v in &mut s.vertices {
-            *v += d;
+            *v = f(*v);
         }
     }
     let parameters = base
@@ -58,10 +36,10 @@ fn shifted(base: &Scene, d: glam::DVec2) -> Result<Scene, geosens::Error> {
         .map(|p| Parameter {
             motion: match p.motion {
                 Motion::Rotate { pivot } => Motion::Rotate {
-                    pivot: pivot.map(|c| c + d),
+                    pivot: pivot.map(&f),
                 },
                 Motion::Scale { pivot } => Motion::Scale {
-                    pivot: pivot.map(|c| c + d),
+                    pivot: pivot.map(&f),
                 },
                 m => m,
             },
@@ -70,7 +48,7 @@ fn shifted(base: &Scene, d: glam::DVec2) -> Result<Scene, geosens::Error> {
         .collect();
     let sensor = match base.sensor() {
         Sensor::Irradiance { point, normal } => Sensor::Irradiance {
-            point: point + d,
+            point: f(point),
             normal,
         },
         s => s,
