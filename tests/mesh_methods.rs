@@ -1430,3 +1430,57 @@ motion = {{ kind = "translate_z" }}
     assert!(caveated(&scene(0.0, delta)).is_empty());
     assert!(caveated(&scene(9e5, 9e5 + 1e-6)).is_empty());
 }
+
+/// Transport's sensor gradient across the plane of a face seen edge-on
+/// (campaign: a lamp edge-on from the sensor over a reflecting floor, ∇z
+/// 0.400 at the origin and 0.417 at 9·10⁵, "reliable"): a caveat on the
+/// axes that cross the plane (z), none on the axes in it, none without
+/// such a plane.
+#[test]
+fn the_sensor_gradient_across_an_edge_on_face_is_a_caveat() {
+    let scene = |lamp_z: f64, floor_z: f64| {
+        let text = format!(
+            r#"
+[sensor]
+kind = "irradiance"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 1.0, 0.0]
+
+[[shapes]]
+name = "lamp"
+vertices = [[-0.5, 1.0, {lamp_z:?}], [0.5, 1.0, {lamp_z:?}], [0.5, 2.0, {lamp_z:?}], [-0.5, 2.0, {lamp_z:?}]]
+triangles = [[0, 1, 2], [0, 2, 3]]
+surface = {{ kind = "emitter", radiance = 1.0 }}
+
+[[shapes]]
+name = "floor"
+vertices = [[-1.0, -0.5, {floor_z:?}], [1.0, -0.5, {floor_z:?}], [1.0, 2.5, {floor_z:?}], [-1.0, 2.5, {floor_z:?}]]
+triangles = [[0, 1, 2], [0, 2, 3]]
+surface = {{ kind = "reflector", albedo = 0.8 }}
+"#
+        );
+        geosens::mesh::file::from_toml(&text).unwrap()
+    };
+    let axes = |s: &Scene| -> Vec<String> {
+        geosens::mesh::methods::plane_kinks_of_the_gradient(s)
+            .into_iter()
+            .map(|(q, _)| q.to_string())
+            .collect()
+    };
+    // The lamp edge-on (its plane z = 0 holds the sensor, off the lamp).
+    assert_eq!(
+        axes(&scene(0.0, -0.5)),
+        [Quantity::gradient("z").to_string()]
+    );
+    // The lamp above, the floor below: no plane through the sensor.
+    assert!(axes(&scene(0.5, -0.5)).is_empty());
+    // And the estimator carries it.
+    let e = Method::Transport
+        .estimator(Arc::new(scene(0.0, -0.5)))
+        .unwrap();
+    assert!(
+        e.caveats()
+            .iter()
+            .any(|(q, _)| *q == Quantity::gradient("z"))
+    );
+}
