@@ -205,7 +205,7 @@ pub fn plane_kinks_of_the_gradient(scene: &Scene) -> Vec<(Quantity, String)> {
                         (b - a).cross(p - a).dot(n) >= -tolerance * (b - a).length()
                     })
                 };
-                (off.abs() <= tolerance && !on_face()).then(|| (i, &shape.name))
+                (off.abs() <= tolerance && !on_face()).then_some((i, &shape.name))
             })
         });
         if let Some((i, name)) = hit {
