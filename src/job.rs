@@ -443,7 +443,8 @@ impl ImageReport {
                 .any(|e| !e.mean.is_finite() || !e.stderr.is_finite())
             {
                 w.push(format!(
-                    "warning: {q}: some pixels are not finite (overflow)"
+                    "warning: {q}: some pixels are not finite (overflow, or an error bar lost to \
+                     underflow)"
                 ));
             }
             // The EXR files hold 32-bit floats (the .npy files doubles).

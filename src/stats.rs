@@ -180,9 +180,16 @@ impl StratumSums {
     /// The pixel's estimate.
     pub fn estimate(&self) -> Estimate {
         let s = f64::from(self.strata.max(1));
+        // A spread lost to underflow in the pooled weights is lost in the
+        // strata's variances too (`Moments::lost_to_underflow`).
+        let stderr = if self.pooled.lost_to_underflow() {
+            f64::NAN
+        } else {
+            self.variances.sqrt() / s
+        };
         Estimate {
             mean: self.means / s,
-            stderr: self.variances.sqrt() / s,
+            stderr,
             ..self.pooled.estimate()
         }
     }
@@ -468,6 +475,14 @@ mod tests {
         let (a, b) = tiny.split_at(500);
         let merged = Moments::of(a).merge(&Moments::of(b)).estimate();
         assert!(merged.stderr.is_nan(), "{merged:?}");
+        // And a pixel's strata.
+        let mut pixel = StratumSums::default();
+        for stratum in tiny.chunks(100) {
+            stratum.iter().for_each(|&w| pixel.push(w));
+            pixel.end_stratum();
+        }
+        let e = pixel.estimate();
+        assert!(e.stderr.is_nan() && !e.is_reliable(), "{e:?}");
     }
 
     /// Two-pass central moments: the independent reference.
