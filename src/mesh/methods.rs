@@ -80,7 +80,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Spac
         .map(|p| Quantity::sensitivity(&p.name))
         .collect();
     if gradient {
-        for axis in ["x", "y", "z"] {
+        for (axis, _) in AXES {
             names.push(Quantity::gradient(axis));
         }
     }
@@ -130,27 +130,13 @@ pub const EDGE_ON_ULPS: f64 = 4096.0;
 /// caveat per parameter of such a mesh.
 pub fn kinks(scene: &Scene) -> Vec<(Quantity, String)> {
     let x = scene.sensor().point();
-    // Far from the origin a face's plane is known to the rounding of its
-    // coordinates: a lamp tilted 9 ulps of 9·10⁵ off edge-on (10⁻⁹ rad)
-    // read I 54σ and ∂I/∂tz 350σ off, "reliable" (campaign; the bias went
-    // as 1/ulps, 3σ at 1 024). EDGE_ON_ULPS of the largest coordinate.
-    let reach = |t: &[glam::DVec3; 3]| {
-        t.iter()
-            .map(|q| q.abs().max_element())
-            .fold(x.abs().max_element(), f64::max)
-    };
     let mut out = Vec::new();
     for (j, p) in scene.parameters().iter().enumerate() {
         let shape = &scene.shapes()[scene.parameter_shape(j) as usize];
         let edge_on = (0..shape.triangles.len()).find(|&i| {
             let t = shape.triangle(i);
-            let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-            let across = t.iter().any(|&q| {
-                let v = p.motion.velocity(q);
-                v.dot(n).abs() > 1e-9 * v.length()
-            });
-            let tolerance = (1e-9 * scene.size()).max(EDGE_ON_ULPS * f64::EPSILON * reach(&t));
-            n != glam::DVec3::ZERO && n.dot(x - t[0]).abs() <= tolerance && across
+            edge_on_plane(scene, x, &t)
+                .is_some_and(|(n, _, _)| t.iter().any(|&q| crosses(p.motion.velocity(q), n)))
         });
         if let Some(i) = edge_on {
             out.push((
@@ -167,6 +153,40 @@ pub fn kinks(scene: &Scene) -> Vec<(Quantity, String)> {
     out
 }
 
+/// The unit normal of face `t`, the sensor's signed distance `off` from
+/// its plane and the tolerance, when `x` lies in that plane: within 10⁻⁹
+/// of the scene's size, or [`EDGE_ON_ULPS`] of the largest coordinate of
+/// the face and `x`. Far from the origin a face's plane is known only to
+/// the rounding of its coordinates: a lamp tilted 9 ulps of 9·10⁵ off
+/// edge-on (10⁻⁹ rad) read I 54σ and ∂I/∂tz 350σ off, "reliable"
+/// (campaign; the bias went as 1/ulps, 3σ at 1 024).
+fn edge_on_plane(
+    scene: &Scene,
+    x: glam::DVec3,
+    t: &[glam::DVec3; 3],
+) -> Option<(glam::DVec3, f64, f64)> {
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+    let reach = t
+        .iter()
+        .map(|q| q.abs().max_element())
+        .fold(x.abs().max_element(), f64::max);
+    let tolerance = (1e-9 * scene.size()).max(EDGE_ON_ULPS * f64::EPSILON * reach);
+    let off = n.dot(x - t[0]);
+    (n != glam::DVec3::ZERO && off.abs() <= tolerance).then_some((n, off, tolerance))
+}
+
+/// Whether a motion at velocity `v` leaves the plane of unit normal `n`.
+fn crosses(v: glam::DVec3, n: glam::DVec3) -> bool {
+    v.dot(n).abs() > 1e-9 * v.length()
+}
+
+/// The sensor's axes, as transport's gradient names them.
+const AXES: [(&str, glam::DVec3); 3] = [
+    ("x", glam::DVec3::X),
+    ("y", glam::DVec3::Y),
+    ("z", glam::DVec3::Z),
+];
+
 /// Where the sensor's gradient may not exist: the sensor lies in the plane
 /// of a face (within [`kinks`]'s tolerance) but off the face itself, so
 /// moving it across that plane turns the face, seen edge-on, to face it
@@ -179,33 +199,19 @@ pub fn kinks(scene: &Scene) -> Vec<(Quantity, String)> {
 pub fn plane_kinks_of_the_gradient(scene: &Scene) -> Vec<(Quantity, String)> {
     let x = scene.sensor().point();
     let mut out = Vec::new();
-    for (axis, e) in [
-        ("x", glam::DVec3::X),
-        ("y", glam::DVec3::Y),
-        ("z", glam::DVec3::Z),
-    ] {
+    for (axis, e) in AXES {
         let hit = scene.shapes().iter().find_map(|shape| {
             (0..shape.triangles.len()).find_map(|i| {
                 let t = shape.triangle(i);
-                let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-                if n == glam::DVec3::ZERO || e.dot(n).abs() <= 1e-9 {
-                    return None;
-                }
-                let reach = t
-                    .iter()
-                    .map(|q| q.abs().max_element())
-                    .fold(x.abs().max_element(), f64::max);
-                let tolerance = (1e-9 * scene.size()).max(EDGE_ON_ULPS * f64::EPSILON * reach);
-                let off = n.dot(x - t[0]);
-                let on_face = || {
-                    // Barycentric signs of the sensor's projection.
-                    let p = x - n * off;
-                    (0..3).all(|k| {
-                        let (a, b) = (t[k], t[(k + 1) % 3]);
-                        (b - a).cross(p - a).dot(n) >= -tolerance * (b - a).length()
-                    })
-                };
-                (off.abs() <= tolerance && !on_face()).then_some((i, &shape.name))
+                let (n, off, tolerance) =
+                    edge_on_plane(scene, x, &t).filter(|&(n, _, _)| crosses(e, n))?;
+                // Barycentric signs of the sensor's projection.
+                let p = x - n * off;
+                let on_face = (0..3).all(|k| {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    (b - a).cross(p - a).dot(n) >= -tolerance * (b - a).length()
+                });
+                (!on_face).then_some((i, &shape.name))
             })
         });
         if let Some((i, name)) = hit {
@@ -450,7 +456,6 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
     // A motion that keeps the moved edge in the plane (a translation along
     // an edge-on face, say) slides it along the tie and crosses no kink,
     // as `kinks` spares it; the sensor's own motion likewise, axis by axis.
-    let across = |v: glam::DVec3, n: glam::DVec3| v.dot(n).abs() > 1e-9 * v.length();
     let why = |ka: u32, kb: u32, along: String| {
         format!(
             "edges of {} lie in one plane through the sensor and overlap as seen from it: I \
@@ -471,7 +476,7 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
     for (j, p) in params.iter().enumerate() {
         let k = scene.parameter_shape(j);
         let crossing = tied.iter().find(|&&(ka, _, n, ends)| {
-            ka == k && ends.iter().any(|&q| across(p.motion.velocity(q), n))
+            ka == k && ends.iter().any(|&q| crosses(p.motion.velocity(q), n))
         });
         if let Some(&(ka, kb, _, _)) = crossing {
             out.push((
@@ -480,12 +485,8 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
             ));
         }
     }
-    for (axis, e) in [
-        ("x", glam::DVec3::X),
-        ("y", glam::DVec3::Y),
-        ("z", glam::DVec3::Z),
-    ] {
-        if let Some(&(ka, kb, _, _)) = tied.iter().find(|&&(_, _, n, _)| across(e, n)) {
+    for (axis, e) in AXES {
+        if let Some(&(ka, kb, _, _)) = tied.iter().find(|&&(_, _, n, _)| crosses(e, n)) {
             out.push((
                 Quantity::gradient(axis),
                 why(ka, kb, format!("the sensor's {axis}")),
