@@ -543,6 +543,12 @@ pub fn reflected_jump<G: Geometry>(
 }
 // ANCHOR_END: reflected_jump
 
+/// How many hits on primitives that hold a boundary point a sight line to
+/// it passes ([`reach`], and flatland's `Scene::sees_corner`): a corner
+/// has two segments and an edge two faces, and rounding may meet each
+/// once; past that the line is taken as blocked rather than walked on.
+pub const HOLDING_PASSES: u32 = 4;
+
 /// Whether `q` is visible from `x` (in `medium`, leaving `skip`): the
 /// transmittance to it and the medium there.
 pub fn reach<G: Geometry>(
@@ -557,15 +563,15 @@ pub fn reach<G: Geometry>(
     let mut left = d.length();
     let w = d * (1.0 / left);
     let mut tau = 0.0;
-    // Hits on primitives that hold q pass (a few: they meet the sight line
-    // only at q, so a hit short of it is rounding; see `Boundaries::holds`).
+    // Hits on primitives that hold q pass (they meet the sight line only
+    // at q, so a hit short of it is rounding; see `Boundaries::holds`).
     let mut passes = 0;
     loop {
         let ke = g.coefficients(medium).map_or(0.0, |c| c.1);
         match g.cast(x, w, skip) {
             Some(h) if h.t < left * (1.0 - 1e-9) => {
                 let opaque = g.surface(h.prim) != Surface::Transparent;
-                if opaque && !(passes < 4 && holds(h.prim)) {
+                if opaque && !(passes < HOLDING_PASSES && holds(h.prim)) {
                     return None;
                 }
                 tau += ke * h.t;

@@ -378,7 +378,8 @@ impl Scene {
                 Some(h) if h.t < left * (1.0 - 1e-9) => {
                     let seg = self.segments[h.segment as usize];
                     let own = seg.a == q || seg.b == q;
-                    if self.shape_of(h.segment).surface.is_opaque() && !(own && passes < 4) {
+                    let passes_left = passes < crate::path::walk::HOLDING_PASSES;
+                    if self.shape_of(h.segment).surface.is_opaque() && !(own && passes_left) {
                         return false;
                     }
                     passes += own as u32;
