@@ -16,9 +16,9 @@
 //!     fd_step: None,
 //! };
 //! let cfg = RunConfig::new(100_000, 7)?;
-//! let single = job.run(&cfg)?;
+//! let single = job.run(&cfg, &|_| {})?;
 //! // The same run in two shards (two processes, two machines), merged.
-//! let states = [1, 2].map(|i| job.run_shard(&cfg, Shard::new(i, 2).unwrap()));
+//! let states = [1, 2].map(|i| job.run_shard(&cfg, Shard::new(i, 2).unwrap(), &|_| {}));
 //! let labelled: Vec<_> = states
 //!     .into_iter()
 //!     .enumerate()
@@ -33,7 +33,7 @@ use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::method::{Method, Problem};
 use crate::report::{Header, Report, RodProbe, rod_exact, rod_quantities};
-use crate::runner::{RunConfig, RunResult, run};
+use crate::runner::{RunConfig, RunResult, run_with_progress};
 use crate::stats::Estimate;
 use crate::{flat, mesh};
 use std::path::{Path, PathBuf};
@@ -285,12 +285,13 @@ impl Job {
     }
 
     /// Runs the job: what `geosens rod`, `flat` or `mesh` prints, as a
-    /// [`Report`].
-    pub fn run(&self, cfg: &RunConfig) -> Result<Report, Error> {
+    /// [`Report`]. `progress` is called with the paths sampled so far
+    /// ([`crate::runner::run_with_progress`]).
+    pub fn run(&self, cfg: &RunConfig, progress: &(dyn Fn(u64) + Sync)) -> Result<Report, Error> {
         crate::runner::check_threads(cfg.threads)?;
         let prepared = self.prepare()?;
         let result = match &prepared.estimator {
-            Some(est) => run(est.as_ref(), cfg)?,
+            Some(est) => run_with_progress(est.as_ref(), cfg, progress)?,
             None => exact_result(&prepared.header)?,
         };
         Ok(Report {

@@ -22,6 +22,7 @@ use crate::rng;
 use crate::stats::{ChunkSums, Estimate, Moments};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Paths per chunk. Part of what a seed means: changing it changes results.
@@ -151,28 +152,35 @@ pub fn blocks(paths: u64) -> u64 {
 
 /// The moments of blocks `blocks`, each its chunks' moments merged in chunk
 /// order, handed to `sink` in block order; the chunks of a batch run in
-/// parallel on the current rayon pool unless `serial`.
+/// parallel on the current rayon pool unless `serial`. After each chunk,
+/// `progress` is called with the paths these blocks have sampled so far
+/// (in no fixed order across threads: a count to show, not to compute with).
 fn run_blocks<E: Estimator + ?Sized>(
     est: &E,
     cfg: &RunConfig,
     blocks: std::ops::Range<u64>,
     serial: bool,
+    progress: &(dyn Fn(u64) + Sync),
     sink: &mut impl FnMut(Vec<Moments>),
 ) {
     let nq = est.quantities().len();
     let chunks = cfg.paths.div_ceil(CHUNK);
     let per_batch = BATCH / BLOCK;
+    let done = AtomicU64::new(0);
+    let chunk = |c: u64| {
+        let moments = run_chunk(est, cfg, nq, c);
+        let len = CHUNK.min(cfg.paths - c * CHUNK);
+        progress(done.fetch_add(len, Ordering::Relaxed) + len);
+        moments
+    };
     let mut first = blocks.start;
     while first < blocks.end {
         let last = blocks.end.min(first + per_batch);
         let range = first * BLOCK..chunks.min(last * BLOCK);
         let per_chunk: Vec<Vec<Moments>> = if serial {
-            range.map(|c| run_chunk(est, cfg, nq, c)).collect()
+            range.map(chunk).collect()
         } else {
-            range
-                .into_par_iter()
-                .map(|c| run_chunk(est, cfg, nq, c))
-                .collect()
+            range.into_par_iter().map(chunk).collect()
         };
         for block in per_chunk.chunks(BLOCK as usize) {
             sink(fold_blocks(nq, block.iter().map(Vec::as_slice)));
@@ -190,11 +198,14 @@ pub fn sample_blocks<E: Estimator + ?Sized>(
     est: &E,
     cfg: &RunConfig,
     blocks: std::ops::Range<u64>,
+    progress: &(dyn Fn(u64) + Sync),
 ) -> Result<(Vec<Vec<Moments>>, f64), Error> {
     check_config(cfg)?;
     let mut out = Vec::new();
     let ((), seconds) = timed_on(cfg.threads, || {
-        run_blocks(est, cfg, blocks, cfg.threads == 1, &mut |b| out.push(b))
+        run_blocks(est, cfg, blocks, cfg.threads == 1, progress, &mut |b| {
+            out.push(b)
+        })
     })?;
     Ok((out, seconds))
 }
@@ -246,13 +257,26 @@ pub(crate) fn timed_on<T: Send>(
 /// [`BATCH`]); a run of [`MAX_PATHS`] starts like any other and runs until
 /// interrupted.
 pub fn run<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig) -> Result<RunResult, Error> {
+    run_with_progress(est, cfg, &|_| {})
+}
+
+/// [`run`], calling `progress` with the paths sampled so far after every
+/// chunk of [`CHUNK`] paths (from the worker threads: keep it cheap, such
+/// as a progress bar's `set_position`). The estimates are [`run`]'s, bit
+/// for bit.
+pub fn run_with_progress<E: Estimator + ?Sized>(
+    est: &E,
+    cfg: &RunConfig,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<RunResult, Error> {
     check_config(cfg)?;
     let quantities = est.quantities();
     let mut total = vec![Moments::default(); quantities.len()];
     let ((), seconds) = timed_on(cfg.threads, || {
         // One thread: no pool to build (a thread spawn per call), same
         // chunks in the same order, so the same bits.
-        run_blocks(est, cfg, 0..blocks(cfg.paths), cfg.threads == 1, &mut |b| {
+        let all = 0..blocks(cfg.paths);
+        run_blocks(est, cfg, all, cfg.threads == 1, progress, &mut |b| {
             merge_into(&mut total, &b)
         })
     })?;

@@ -64,6 +64,11 @@ impl Shard {
         let at = |i: u64| (u128::from(total) * u128::from(i) / u128::from(self.count)) as u64;
         at(self.index - 1)..at(self.index)
     }
+
+    /// The paths this shard samples of a run of `paths` paths.
+    pub fn paths(&self, paths: u64) -> u64 {
+        paths_in(&self.blocks(runner::blocks(paths)), paths)
+    }
 }
 
 impl fmt::Display for Shard {
@@ -316,17 +321,23 @@ fn paths_in(blocks: &Range<u64>, paths: u64) -> u64 {
 }
 
 impl Job {
-    /// Runs shard `shard` of the job's run `cfg` and returns its state.
-    /// Errors as [`Job::run`] does, and for the rod's exact solution
-    /// (nothing to sample).
-    pub fn run_shard(&self, cfg: &RunConfig, shard: Shard) -> Result<State, Error> {
+    /// Runs shard `shard` of the job's run `cfg` and returns its state;
+    /// `progress` is called with the shard's paths sampled so far. Errors
+    /// as [`Job::run`] does, and for the rod's exact solution (nothing to
+    /// sample).
+    pub fn run_shard(
+        &self,
+        cfg: &RunConfig,
+        shard: Shard,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<State, Error> {
         let prepared = self.prepare()?;
         let est = prepared.estimator.as_ref().ok_or_else(|| {
             Error::Config("the exact solution samples nothing: it has no shards".into())
         })?;
         let total = runner::blocks(cfg.paths);
         let range = shard.blocks(total);
-        let (moments, seconds) = runner::sample_blocks(est.as_ref(), cfg, range.clone())?;
+        let (moments, seconds) = runner::sample_blocks(est.as_ref(), cfg, range.clone(), progress)?;
         Ok(State {
             format: STATE_FORMAT.to_owned(),
             version: env!("CARGO_PKG_VERSION").to_owned(),

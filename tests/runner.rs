@@ -4,7 +4,7 @@
 //! refused with a message.
 use geosens::estimator::{Estimator, Quantity};
 use geosens::rng::{self, PathRng};
-use geosens::runner::{BLOCK, CHUNK, RunConfig, run};
+use geosens::runner::{BLOCK, CHUNK, RunConfig, run, run_with_progress};
 use geosens::stats::{ChunkSums, Moments};
 use rand::Rng;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -74,6 +74,27 @@ fn batches_merge_in_chunk_order_for_any_thread_count() {
         let got: Vec<_> = r.estimates.iter().map(|(_, e)| *e).collect();
         // Bit-identical, the NaN-free way: PartialEq on every field.
         assert_eq!(got, reference, "{threads} threads");
+    }
+}
+
+/// A run that reports its progress gives the same bits, and its reports
+/// count every path once: they rise to the path count (a partial last
+/// chunk included), each a multiple of the chunk or the total.
+#[test]
+fn progress_counts_every_path_and_changes_no_bit() {
+    let paths = 40 * CHUNK + 77;
+    for threads in [1, 3] {
+        let cfg = RunConfig::new(paths, 9).unwrap().threads(threads);
+        let (calls, last) = (AtomicU64::new(0), AtomicU64::new(0));
+        let with = run_with_progress(&Cheap, &cfg, &|done| {
+            assert!(done <= paths, "{done} of {paths}");
+            calls.fetch_add(1, Ordering::Relaxed);
+            last.fetch_max(done, Ordering::Relaxed);
+        })
+        .unwrap();
+        assert_eq!(with.estimates, run(&Cheap, &cfg).unwrap().estimates);
+        assert_eq!(calls.into_inner(), paths.div_ceil(CHUNK));
+        assert_eq!(last.into_inner(), paths);
     }
 }
 

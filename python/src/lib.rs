@@ -100,8 +100,10 @@ fn estimate(
     let out = py.detach(|| -> Result<Output, Error> {
         let cfg = RunConfig::new(paths, seed)?.threads(threads);
         match shard {
-            None => job.run(&cfg).map(Output::Report),
-            Some((i, n)) => job.run_shard(&cfg, Shard::new(i, n)?).map(Output::State),
+            None => job.run(&cfg, &|_| {}).map(Output::Report),
+            Some((i, n)) => job
+                .run_shard(&cfg, Shard::new(i, n)?, &|_| {})
+                .map(Output::State),
         }
     });
     out.and_then(|o| o.into_py(py)).map_err(value_error)

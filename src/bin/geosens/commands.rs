@@ -1,5 +1,6 @@
 //! The subcommands: `rod`, `compare` and `flat`, each printing a table or
 //! one JSON line.
+use super::output::progress_bar;
 use super::*;
 use geosens::report::{RodProbe, yes_no, z_text};
 use geosens::shard::Merged;
@@ -39,7 +40,14 @@ fn estimate(
             ))
             .into());
         }
-        return print_report(&job.run(&cfg)?, json, out);
+        let bar = progress_bar(
+            cfg.paths,
+            "paths",
+            job.method.map_or("exact", Method::name).to_owned(),
+        );
+        let report = job.run(&cfg, &|done| bar.set_position(done));
+        bar.finish_and_clear();
+        return print_report(&report?, json, out);
     };
     if json {
         return Err(Error::Config(
@@ -50,7 +58,14 @@ fn estimate(
     }
     super::output::writable_file(path)?;
     let which = shard.shard.unwrap_or(Shard::WHOLE);
-    let state = job.run_shard(&cfg, which)?;
+    let bar = progress_bar(
+        which.paths(cfg.paths),
+        "paths",
+        format!("{} shard {which}", job.method.map_or("exact", Method::name)),
+    );
+    let state = job.run_shard(&cfg, which, &|done| bar.set_position(done));
+    bar.finish_and_clear();
+    let state = state?;
     state.write(path)?;
     eprintln!(
         "wrote shard {which} ({} of {} paths, {:.2} s) to {}",

@@ -37,3 +37,17 @@ pub(super) fn writable_file(path: &Path) -> Result<(), Error> {
     }
     writable_dir(parent)
 }
+
+/// A progress bar on stderr for `len` units of work (`unit`: "paths",
+/// "rows"), drawn only where stderr is a terminal (indicatif's own check):
+/// a long run in a terminal shows it is alive and when it will end, and a
+/// script's or a cluster job's stderr stays clean.
+pub(super) fn progress_bar(len: u64, unit: &str, msg: String) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len);
+    let template = format!("{{msg}} [{{bar:40}}] {{human_pos}}/{{human_len}} {unit}, eta {{eta}}");
+    if let Ok(style) = indicatif::ProgressStyle::with_template(&template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(msg);
+    bar
+}

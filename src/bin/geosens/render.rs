@@ -147,13 +147,11 @@ pub(super) fn render_command(
     let (estimator, _) = job.prepare()?;
     super::output::writable_dir(dir)?;
     let rows = estimator.image().map_or(0, |(_, h)| h);
-    let bar = indicatif::ProgressBar::new(u64::from(rows));
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, eta {eta}")
-            .map_err(|e| Error::Output(e.to_string()))?
-            .progress_chars("=> "),
+    let bar = super::output::progress_bar(
+        u64::from(rows),
+        "rows",
+        format!("render {}", estimator.method()),
     );
-    bar.set_message(format!("render {}", estimator.method()));
     let result = render(
         estimator.as_ref(),
         args.spp,
