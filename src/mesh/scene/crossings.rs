@@ -2,7 +2,7 @@
 //! meshes' boxes and then over their triangles, and the exact f64 test of
 //! each close pair ([`triangles_within`]).
 use super::Shape;
-use super::geometry::triangles_within;
+use super::geometry::{segment_triangle_distance, triangles_within};
 use super::validate::{TOUCH_DISTANCE, bounds, config};
 use crate::error::Error;
 use glam::DVec3;
@@ -86,15 +86,29 @@ fn check_pair(shapes: &[Shape], k: usize, l: usize, boxes: &[Aabb], tol: f64) ->
     Ok(())
 }
 
-/// Rejects a mesh with a medium whose triangles cross or touch one another
-/// (two boxes given as one mesh): a path finds the medium by the parity of
-/// the boundaries it crosses, which is wrong where the mesh overlaps
-/// itself. The same sweep over x as [`check_pair`], within one mesh;
-/// triangles that share a vertex are the mesh's own contact, not tested.
+/// Rejects a mesh whose triangles touch or cross one another anywhere but
+/// along the vertices and edges they share. With a medium, a path finds
+/// the medium by the parity of the boundaries it crosses, wrong where the
+/// mesh overlaps itself (two boxes given as one mesh). On any mesh, the
+/// boundary terms count each silhouette edge once, so an edge lying on
+/// another (a T-junction: a vertex in the middle of another triangle's
+/// edge; a seam left unwelded on a face), or a triangle folded back onto
+/// its neighbour, counted a silhouette twice or lost one: `rendering` and
+/// `transport` read up to twice the derivative, "reliable". The test, by
+/// what a pair of triangles shares (the same sweep over x as
+/// [`check_pair`]):
+/// - nothing: they must stay [`TOUCH_DISTANCE`] × `size` apart
+///   ([`triangles_within`]);
+/// - one vertex: each one's edge opposite that vertex must stay that far
+///   from the other (two triangles that meet at a vertex overlap just when
+///   one of those edges reaches the other triangle);
+/// - an edge: they must not lie in one plane on the same side of it (a
+///   fold; in one plane on either side is a flat face).
+///
 /// Flatland refuses a polygon that intersects itself likewise.
 pub(super) fn check_self_crossings(shapes: &[Shape], size: f64) -> Result<(), Error> {
     let tol = TOUCH_DISTANCE * size;
-    for s in shapes.iter().filter(|s| s.medium.is_some()) {
+    for s in shapes {
         let mut items: Vec<(Aabb, u32)> = (0..s.triangles.len())
             .map(|i| (Aabb::of(&s.triangle(i)), i as u32))
             .collect();
@@ -102,17 +116,19 @@ pub(super) fn check_self_crossings(shapes: &[Shape], size: f64) -> Result<(), Er
         let mut active: Vec<(Aabb, u32)> = Vec::new();
         for &(b, i) in &items {
             active.retain(|(o, _)| o.hi.x + tol >= b.lo.x);
-            let ti = s.triangles[i as usize];
             for &(o, j) in &active {
-                let tj = s.triangles[j as usize];
-                if !b.meets(&o, tol) || ti.iter().any(|v| tj.contains(v)) {
-                    continue;
-                }
-                if triangles_within(s.triangle(i as usize), s.triangle(j as usize), tol) {
+                if b.meets(&o, tol)
+                    && let Some(why) = self_contact(s, i as usize, j as usize, tol)
+                {
                     let (a, b) = (i.min(j), i.max(j));
+                    let what = if s.medium.is_some() {
+                        "a mesh with a medium must bound one region"
+                    } else {
+                        "a mesh's triangles may meet only at the vertices and edges they share \
+                         (split the edge at the vertex on it, or weld the seam)"
+                    };
                     return config(format!(
-                        "shape {:?} crosses itself (triangles {a} and {b}): a mesh with a \
-                         medium must bound one region",
+                        "shape {:?} {why} (triangles {a} and {b}): {what}",
                         s.name
                     ));
                 }
@@ -121,4 +137,44 @@ pub(super) fn check_self_crossings(shapes: &[Shape], size: f64) -> Result<(), Er
         }
     }
     Ok(())
+}
+
+/// How triangles `i` and `j` of `s` meet where they should not, if they
+/// do (see [`check_self_crossings`]).
+fn self_contact(s: &Shape, i: usize, j: usize, tol: f64) -> Option<&'static str> {
+    let (ti, tj) = (s.triangles[i], s.triangles[j]);
+    let (mut shared, mut n) = ([0usize; 3], 0);
+    for (k, v) in ti.iter().enumerate() {
+        if tj.contains(v) {
+            shared[n] = k;
+            n += 1;
+        }
+    }
+    let (pi, pj) = (s.triangle(i), s.triangle(j));
+    match shared[..n] {
+        [] => triangles_within(pi, pj, tol).then_some("crosses itself"),
+        [k] => {
+            let v = ti[k];
+            let opposite = |t: [u32; 3], p: [DVec3; 3]| {
+                let m = t.iter().position(|&x| x == v).unwrap_or(0);
+                (p[(m + 1) % 3], p[(m + 2) % 3])
+            };
+            let ((a, b), (c, d)) = (opposite(ti, pi), opposite(tj, pj));
+            (segment_triangle_distance(a, b, pj) <= tol
+                || segment_triangle_distance(c, d, pi) <= tol)
+                .then_some("overlaps itself at a vertex")
+        }
+        [k, l] => {
+            // The edge (a, b) and each triangle's third corner.
+            let (a, b) = (pi[k], pi[l]);
+            let ci = pi[3 - k - l];
+            let m = (0..3).find(|&m| !ti.contains(&tj[m])).unwrap_or(0);
+            let cj = pj[m];
+            let n = (b - a).cross(ci - a);
+            let off = n.dot(cj - a) / n.length();
+            let same_side = (b - a).cross(ci - a).dot((b - a).cross(cj - a)) > 0.0;
+            (off.abs() <= tol && same_side).then_some("folds onto itself along an edge")
+        }
+        _ => None,
+    }
 }

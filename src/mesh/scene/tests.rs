@@ -487,3 +487,94 @@ fn bad_parameters_and_sensors_are_rejected_with_a_reason() {
     };
     assert_err(shapes(), vec![], radiance, "sensor direction");
 }
+
+/// A mesh whose triangles meet anywhere but at shared vertices and edges
+/// is refused: the boundary terms counted an edge lying on another edge or
+/// face twice (2× the derivative, "reliable"), and lost the edge of a fold.
+/// Each bad mesh beside its sound twin, which loads.
+#[test]
+fn a_mesh_touching_itself_is_rejected() {
+    let v = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+    let occ = |vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>| Shape {
+        name: "occ".into(),
+        vertices,
+        triangles,
+        surface: Surface::Absorber,
+        medium: None,
+    };
+    let check = |shape: Shape, part: Option<&str>| {
+        let r = Scene::new(vec![lamp(), shape], vec![], irradiance());
+        match (r, part) {
+            (Err(e), Some(part)) => assert!(e.to_string().contains(part), "{part:?} not in {e}"),
+            (Ok(_), None) => {}
+            (r, part) => panic!("{part:?}: {:?}", r.err()),
+        }
+    };
+    // An "L": a square at z = 1 and a wall rising from its edge x = -0.05,
+    // split at y = 0.1: a T-junction on the fold. With the floor's edge
+    // split there too, the same L is sound.
+    let floor = [
+        v(-0.05, -0.15, 1.0),
+        v(0.45, -0.15, 1.0),
+        v(0.45, 0.35, 1.0),
+        v(-0.05, 0.35, 1.0),
+    ];
+    let wall = [
+        v(-0.05, -0.15, 1.5),
+        v(-0.05, 0.35, 1.5),
+        v(-0.05, 0.1, 1.0),
+        v(-0.05, 0.1, 1.5),
+    ];
+    let all: Vec<DVec3> = floor.iter().chain(&wall).copied().collect();
+    let wall_tris = [[0, 6, 7], [0, 7, 4], [6, 3, 5], [6, 5, 7]];
+    let mut t = vec![[0, 1, 2], [0, 2, 3]];
+    t.extend(wall_tris);
+    check(occ(all.clone(), t), Some("overlaps itself at a vertex"));
+    let mut t = vec![[0, 1, 2], [0, 2, 6], [6, 2, 3]];
+    t.extend(wall_tris);
+    check(occ(all, t), None);
+    // The wall's own corners 1e-9 inside the floor (an unwelded seam): its
+    // bottom edge lies on the floor. 1e-6 above it, apart: sound.
+    for (dz, dx, part) in [(0.0, 1e-9, Some("crosses itself")), (1e-6, 0.0, None)] {
+        let mut vs = floor.to_vec();
+        vs.extend([
+            v(-0.05 + dx, -0.15, 1.0 + dz),
+            v(-0.05 + dx, 0.35, 1.0 + dz),
+            wall[0],
+            wall[1],
+        ]);
+        check(
+            occ(vs, vec![[0, 1, 2], [0, 2, 3], [4, 5, 7], [4, 7, 6]]),
+            part,
+        );
+    }
+    // A triangle folded back onto its neighbour, both windings; unfolded
+    // (its third corner across the edge), a flat face.
+    let (a, b, c) = (
+        v(-0.05, -0.15, 1.0),
+        v(0.45, -0.15, 1.0),
+        v(0.45, 0.35, 1.0),
+    );
+    for (m, tri, part) in [
+        (v(0.3, 0.0, 1.0), [0, 2, 3], Some("folds onto itself")),
+        (v(0.3, 0.0, 1.0), [0, 3, 2], Some("folds onto itself")),
+        (v(0.0, 0.3, 1.0), [0, 2, 3], None),
+    ] {
+        check(occ(vec![a, b, c, m], vec![[0, 1, 2], tri]), part);
+    }
+    // A concave pentagon fanned from a convex corner: its first and last
+    // triangles overlap, meeting at that corner only.
+    let pentagon = vec![
+        v(0.0, -0.2, 1.0),
+        v(0.4, -0.2, 1.0),
+        v(0.1, 0.0, 1.0),
+        v(0.4, 0.2, 1.0),
+        v(0.0, 0.2, 1.0),
+    ];
+    check(
+        occ(pentagon.clone(), vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]),
+        Some("itself"),
+    );
+    // Fanned from the reflex corner: a sound triangulation.
+    check(occ(pentagon, vec![[2, 3, 4], [2, 4, 0], [2, 0, 1]]), None);
+}

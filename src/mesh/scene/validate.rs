@@ -93,7 +93,8 @@ impl Scene {
     /// albedo ∉ `[0, 1]`), a medium too thick ([`MAX_OPTICAL_THICKNESS`]), a
     /// size outside [`MIN_SIZE`](super::MIN_SIZE)..[`MAX_SIZE`](super::MAX_SIZE) or
     /// too far from the origin ([`MAX_OFFSET`](super::MAX_OFFSET)), two meshes that cross or
-    /// touch ([`TOUCH_DISTANCE`]), a mesh with a medium that crosses itself,
+    /// touch ([`TOUCH_DISTANCE`]), a mesh that crosses, touches
+    /// or folds onto itself (a T-junction, an unwelded seam),
     /// bad parameters (too many, empty or
     /// repeated names, unknown shapes, zero or non-finite axes and pivots),
     /// a non-finite sensor, a sensor on a surface or inside an opaque closed
@@ -129,8 +130,10 @@ impl Scene {
             }
         }
         check_crossings(&shapes, size)?;
-        check_self_crossings(&shapes, size)?;
+        // After `orient`, whose "encloses no volume" names a closed mesh
+        // flattened onto itself more plainly than the fold it also is.
         let volume = orient(&mut shapes, &closed)?;
+        check_self_crossings(&shapes, size)?;
         let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters, size)?;
         let sensor = check_sensor(sensor, &shapes, &closed, size)?;
         check_optical_thickness(&shapes, size)?;
