@@ -119,7 +119,7 @@ fn main() {
         Method::Fd,
     ] {
         let est = scene.estimator(method, None).expect("estimator");
-        let quiet = |_: u64| {};
+        let quiet = geosens::runner::quiet;
         let p = render(est.as_ref(), pilot, 1, threads, &quiet).expect("pilot render");
         let worst = rels(&p).iter().map(|x| x.1).fold(0.0, f64::max);
         let predicted = ((pilot as f64) * (worst / TARGET).powi(2)).ceil().max(2.0) as u64;

@@ -30,6 +30,10 @@ pub enum Error {
     /// Writing a result (figure, table) failed.
     #[error("{0}")]
     Output(String),
+    /// A run was stopped before its end by its progress hook
+    /// ([`crate::runner::Progress`]): an interrupt, a time budget.
+    #[error("stopped before the end: {0}")]
+    Stopped(String),
 }
 
 /// Checks that `value` is finite and satisfies `ok`, or names it in an error.

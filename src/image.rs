@@ -14,6 +14,7 @@
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::rng;
+use crate::runner::{Progress, Stop};
 use crate::stats::{Estimate, Moments, StratumSums};
 use rayon::prelude::*;
 
@@ -153,7 +154,8 @@ pub fn check_image_memory(
 
 /// Renders rows `rows` of `est`'s camera, `spp` paths per pixel from
 /// `seed` on `threads` threads (0: all cores); `progress` is called with
-/// the number of rows done after each row. Returns, per pixel of those rows
+/// the number of pixels done after each pixel, and its error stops the
+/// rendering at the next pixel ([`Progress`]). Returns, per pixel of those rows
 /// (row-major) and per quantity, its [`PixelSums`], and the wall time. A
 /// pixel's samples depend on its index only, so any split of the rows gives
 /// the same pixels. Errors as [`render`].
@@ -163,7 +165,7 @@ pub fn render_rows(
     seed: u64,
     threads: usize,
     rows: std::ops::Range<u32>,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: Progress,
 ) -> Result<(Vec<Vec<PixelSums>>, f64), Error> {
     let (width, _) = image_size(est, spp)?;
     crate::runner::check_threads(threads)?;
@@ -171,17 +173,22 @@ pub fn render_rows(
     let pixels = u64::from(width) * u64::from(rows.end.saturating_sub(rows.start));
     check_image_memory(pixels, nq, available_memory())?;
     let done = std::sync::atomic::AtomicU64::new(0);
+    let stop = Stop::default();
     let row = |r: u32| -> Vec<Vec<PixelSums>> {
-        let out = (0..width)
-            .map(|c| {
-                let p = r * width + c;
-                let mut rng = rng::stream(seed, p as u64);
-                let mut sums = vec![StratumSums::default(); nq];
-                est.accumulate_pixel(&mut rng, p, spp, &mut sums);
-                sums.iter().map(PixelSums::of).collect()
-            })
-            .collect();
-        progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+        let mut out = Vec::with_capacity(width as usize);
+        for c in 0..width {
+            if stop.stopping() {
+                break;
+            }
+            let p = r * width + c;
+            let mut rng = rng::stream(seed, p as u64);
+            let mut sums = vec![StratumSums::default(); nq];
+            est.accumulate_pixel(&mut rng, p, spp, &mut sums);
+            out.push(sums.iter().map(PixelSums::of).collect());
+            stop.check(progress(
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+            ));
+        }
         out
     };
     let (rows, seconds) = crate::runner::timed_on(threads, || -> Vec<Vec<Vec<PixelSums>>> {
@@ -191,6 +198,7 @@ pub fn render_rows(
             rows.into_par_iter().map(row).collect()
         }
     })?;
+    stop.into_result()?;
     Ok((rows.into_iter().flatten().collect(), seconds))
 }
 
@@ -240,7 +248,8 @@ pub fn assemble(
 
 /// Runs `est` (a camera's) with `spp` paths per pixel from `seed` on
 /// `threads` threads (0: all cores); `progress` is called with the number of
-/// rows done after each row. Errors if the estimator has no camera, `spp`
+/// pixels done after each pixel ([`Progress`]: its error stops the
+/// rendering and is returned). Errors if the estimator has no camera, `spp`
 /// is below 2 or above [`MAX_SPP`], `threads` above
 /// [`MAX_THREADS`](crate::runner::MAX_THREADS), the image would not fit in
 /// the memory free ([`check_image_memory`]), or the pool cannot start.
@@ -249,7 +258,7 @@ pub fn render(
     spp: u64,
     seed: u64,
     threads: usize,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: Progress,
 ) -> Result<ImageResult, Error> {
     let size = image_size(est, spp)?;
     let (pixels, seconds) = render_rows(est, spp, seed, threads, 0..size.1, progress)?;

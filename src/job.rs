@@ -16,9 +16,9 @@
 //!     fd_step: None,
 //! };
 //! let cfg = RunConfig::new(100_000, 7)?;
-//! let single = job.run(&cfg, &|_| {})?;
+//! let single = job.run(&cfg, &geosens::runner::quiet)?;
 //! // The same run in two shards (two processes, two machines), merged.
-//! let states = [1, 2].map(|i| job.run_shard(&cfg, Shard::new(i, 2).unwrap(), &|_| {}));
+//! let states = [1, 2].map(|i| job.run_shard(&cfg, Shard::new(i, 2).unwrap(), &geosens::runner::quiet));
 //! let labelled: Vec<_> = states
 //!     .into_iter()
 //!     .enumerate()
@@ -87,8 +87,9 @@ impl SceneSource {
         }
     }
 
-    /// The scene's dimension (2 or 3, by its sensor's point).
-    pub fn dimension(&self) -> Result<usize, Error> {
+    /// The scene's dimension (2 or 3, by its sensor's point), if it says
+    /// ([`flat::file::dimension_of`]).
+    pub fn dimension(&self) -> Result<Option<usize>, Error> {
         match self {
             SceneSource::File(p) => flat::file::dimension(p),
             SceneSource::Json(text) => {
@@ -99,20 +100,21 @@ impl SceneSource {
         }
     }
 
-    /// Errors unless the scene is of dimension `want`, with a message that
-    /// names the command to use (the loader's own would name a field).
+    /// Errors if the scene is of another dimension than `want`, with a
+    /// message that names the command to use (the loader's own would name
+    /// a field); a scene that does not say is left to the loader.
     fn check_dimension(&self, want: usize) -> Result<(), Error> {
-        let got = self.dimension()?;
-        if got == want {
-            return Ok(());
-        }
+        let got = match self.dimension()? {
+            Some(got) if got != want => got,
+            _ => return Ok(()),
+        };
         let (is, use_) = if got == 2 {
             ("a flatland (2D) scene", "flat")
         } else {
             ("a 3D scene", "mesh")
         };
         Err(Error::Scene(format!(
-            "{}: this is {is} (its sensor's point has {got} coordinates): use `geosens {use_}`",
+            "{}: this is {is} (its points have {got} coordinates): use `geosens {use_}`",
             self.name()
         )))
     }
@@ -287,7 +289,7 @@ impl Job {
     /// Runs the job: what `geosens rod`, `flat` or `mesh` prints, as a
     /// [`Report`]. `progress` is called with the paths sampled so far
     /// ([`crate::runner::run_with_progress`]).
-    pub fn run(&self, cfg: &RunConfig, progress: &(dyn Fn(u64) + Sync)) -> Result<Report, Error> {
+    pub fn run(&self, cfg: &RunConfig, progress: crate::runner::Progress) -> Result<Report, Error> {
         crate::runner::check_threads(cfg.threads)?;
         let prepared = self.prepare()?;
         let result = match &prepared.estimator {
@@ -375,7 +377,7 @@ impl RenderJob {
     /// checks that the sensor is a camera.
     pub fn prepare(&self) -> Result<(Box<dyn Estimator>, Canonical), Error> {
         check_fd_step(Some(self.method), self.fd_step)?;
-        let flat = self.scene.dimension()? == 2;
+        let flat = self.scene.dimension()? == Some(2);
         let (est, _, canonical) = self.scene.estimator(flat, self.method, self.fd_step)?;
         if est.image().is_none() {
             return Err(Error::Config(format!(
@@ -388,13 +390,14 @@ impl RenderJob {
     }
 
     /// Renders every pixel with `spp` paths from `seed` on `threads`
-    /// threads (0: all cores); `progress` is called with the rows done.
+    /// threads (0: all cores); `progress` is called with the pixels done
+    /// ([`crate::runner::Progress`]).
     pub fn run(
         &self,
         spp: u64,
         seed: u64,
         threads: usize,
-        progress: &(dyn Fn(u64) + Sync),
+        progress: crate::runner::Progress,
     ) -> Result<ImageReport, Error> {
         let (est, _) = self.prepare()?;
         let result = crate::image::render(est.as_ref(), spp, seed, threads, progress)?;

@@ -45,6 +45,45 @@ pub const BATCH: u64 = 1024;
 /// counts in `f64`). At 10⁸ paths a second it would take three years.
 pub const MAX_PATHS: u64 = 1 << 53;
 
+/// What a run calls after each chunk of [`CHUNK`] paths (a rendering after
+/// each row) with the work done so far, from the worker threads: to show
+/// it (a progress bar's `set_position`: keep it cheap), and to stop the run
+/// by returning an error (an interrupt, a time budget), which the run
+/// returns once the chunks under way have ended. Progress changes no bit of
+/// a run that ends.
+pub type Progress<'a> = &'a (dyn Fn(u64) -> Result<(), Error> + Sync);
+
+/// The progress hook that shows nothing and never stops a run.
+pub fn quiet(_done: u64) -> Result<(), Error> {
+    Ok(())
+}
+
+/// The first error a progress hook returned, shared by the workers: once
+/// set, the chunks not yet started are skipped.
+#[derive(Default)]
+pub(crate) struct Stop(std::sync::OnceLock<Error>);
+
+impl Stop {
+    /// Whether the run is stopping.
+    #[inline]
+    pub(crate) fn stopping(&self) -> bool {
+        self.0.get().is_some()
+    }
+
+    /// Records the hook's verdict.
+    #[inline]
+    pub(crate) fn check(&self, verdict: Result<(), Error>) {
+        if let Err(e) = verdict {
+            let _ = self.0.set(e);
+        }
+    }
+
+    /// The error that stopped the run, if any.
+    pub(crate) fn into_result(self) -> Result<(), Error> {
+        self.0.into_inner().map_or(Ok(()), Err)
+    }
+}
+
 /// Most worker threads a run accepts: beyond it a pool would cost more to
 /// start than the runs it serves (and rayon itself stops at 65535).
 pub const MAX_THREADS: usize = 1024;
@@ -154,23 +193,29 @@ pub fn blocks(paths: u64) -> u64 {
 /// order, handed to `sink` in block order; the chunks of a batch run in
 /// parallel on the current rayon pool unless `serial`. After each chunk,
 /// `progress` is called with the paths these blocks have sampled so far
-/// (in no fixed order across threads: a count to show, not to compute with).
+/// (in no fixed order across threads: a count to show, not to compute
+/// with); its error stops the run, after the chunks under way, and is
+/// returned.
 fn run_blocks<E: Estimator + ?Sized>(
     est: &E,
     cfg: &RunConfig,
     blocks: std::ops::Range<u64>,
     serial: bool,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: Progress,
     sink: &mut impl FnMut(Vec<Moments>),
-) {
+) -> Result<(), Error> {
     let nq = est.quantities().len();
     let chunks = cfg.paths.div_ceil(CHUNK);
     let per_batch = BATCH / BLOCK;
     let done = AtomicU64::new(0);
+    let stop = Stop::default();
     let chunk = |c: u64| {
+        if stop.stopping() {
+            return Vec::new();
+        }
         let moments = run_chunk(est, cfg, nq, c);
         let len = CHUNK.min(cfg.paths - c * CHUNK);
-        progress(done.fetch_add(len, Ordering::Relaxed) + len);
+        stop.check(progress(done.fetch_add(len, Ordering::Relaxed) + len));
         moments
     };
     let mut first = blocks.start;
@@ -182,11 +227,15 @@ fn run_blocks<E: Estimator + ?Sized>(
         } else {
             range.into_par_iter().map(chunk).collect()
         };
+        if stop.stopping() {
+            break;
+        }
         for block in per_chunk.chunks(BLOCK as usize) {
             sink(fold_blocks(nq, block.iter().map(Vec::as_slice)));
         }
         first = last;
     }
+    stop.into_result()
 }
 
 /// Samples blocks `blocks` of the run `cfg` of `est` on `cfg.threads`
@@ -198,15 +247,16 @@ pub fn sample_blocks<E: Estimator + ?Sized>(
     est: &E,
     cfg: &RunConfig,
     blocks: std::ops::Range<u64>,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: Progress,
 ) -> Result<(Vec<Vec<Moments>>, f64), Error> {
     check_config(cfg)?;
     let mut out = Vec::new();
-    let ((), seconds) = timed_on(cfg.threads, || {
+    let (ended, seconds) = timed_on(cfg.threads, || {
         run_blocks(est, cfg, blocks, cfg.threads == 1, progress, &mut |b| {
             out.push(b)
         })
     })?;
+    ended?;
     Ok((out, seconds))
 }
 
@@ -257,22 +307,22 @@ pub(crate) fn timed_on<T: Send>(
 /// [`BATCH`]); a run of [`MAX_PATHS`] starts like any other and runs until
 /// interrupted.
 pub fn run<E: Estimator + ?Sized>(est: &E, cfg: &RunConfig) -> Result<RunResult, Error> {
-    run_with_progress(est, cfg, &|_| {})
+    run_with_progress(est, cfg, &quiet)
 }
 
 /// [`run`], calling `progress` with the paths sampled so far after every
-/// chunk of [`CHUNK`] paths (from the worker threads: keep it cheap, such
-/// as a progress bar's `set_position`). The estimates are [`run`]'s, bit
-/// for bit.
+/// chunk of [`CHUNK`] paths ([`Progress`]): the estimates are [`run`]'s,
+/// bit for bit, unless the hook stops the run, whose error is then
+/// returned.
 pub fn run_with_progress<E: Estimator + ?Sized>(
     est: &E,
     cfg: &RunConfig,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: Progress,
 ) -> Result<RunResult, Error> {
     check_config(cfg)?;
     let quantities = est.quantities();
     let mut total = vec![Moments::default(); quantities.len()];
-    let ((), seconds) = timed_on(cfg.threads, || {
+    let (ended, seconds) = timed_on(cfg.threads, || {
         // One thread: no pool to build (a thread spawn per call), same
         // chunks in the same order, so the same bits.
         let all = 0..blocks(cfg.paths);
@@ -280,6 +330,7 @@ pub fn run_with_progress<E: Estimator + ?Sized>(
             merge_into(&mut total, &b)
         })
     })?;
+    ended?;
     Ok(RunResult {
         method: est.method(),
         estimates: quantities

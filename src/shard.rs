@@ -14,6 +14,7 @@
 //! would lose NaN and infinity, which an overflowed run must keep).
 use crate::error::Error;
 use crate::estimator::Quantity;
+use crate::flat::file::read_bytes_capped;
 use crate::image::{PixelSums, assemble, render_rows};
 use crate::job::{ImageReport, Job, RenderJob};
 use crate::method::Method;
@@ -28,6 +29,12 @@ use std::str::FromStr;
 
 /// The format tag of a state file; a reader refuses any other.
 pub const STATE_FORMAT: &str = "geosens-state/1";
+
+/// Largest state file [`State::read`] reads (bytes): 4 GiB, some 25
+/// million blocks × quantities at about 170 bytes each (a state of
+/// 10¹⁰ paths and 100 quantities is 2.6 GB). A path that names an endless
+/// stream stops there, or at its first byte when that is not `{`.
+pub const MAX_STATE_BYTES: u64 = 4 << 30;
 
 /// Most shards a run may be split into.
 pub const MAX_SHARDS: u64 = 1 << 20;
@@ -254,8 +261,9 @@ impl State {
     /// negative time printed as such).
     fn check(&self) -> Result<(), Error> {
         let bad = |what: String| Err(Error::Merge(format!("a damaged state: {what}")));
-        if !(self.seconds.is_finite() && self.seconds >= 0.0) {
-            return bad(format!("its time is {} s", self.seconds));
+        // A run's time beyond 10¹² s (31 700 years) is damage too.
+        if !(self.seconds >= 0.0 && self.seconds < 1e12) {
+            return bad(format!("its time is {} s", crate::error::Num(self.seconds)));
         }
         let packed: Vec<&[u64]> = match &self.payload {
             Payload::Blocks { moments, .. } => moments.iter().flatten().map(|p| &p[..]).collect(),
@@ -297,10 +305,13 @@ impl State {
 
     /// Reads the state file at `path`; errors name it (`cannot read FILE:
     /// …`, `FILE: not a geosens state …`).
+    /// At most [`MAX_STATE_BYTES`] are read, and a pipe is refused.
     pub fn read(path: &std::path::Path) -> Result<State, Error> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::Merge(format!("cannot read {name}: {e}")))?;
+        let cannot = |why: &dyn fmt::Display| Error::Merge(format!("cannot read {name}: {why}"));
+        let bytes = read_bytes_capped(path, MAX_STATE_BYTES, Some(b'{')).map_err(|e| cannot(&e))?;
+        let text =
+            String::from_utf8(bytes).map_err(|e| cannot(&format!("not UTF-8 text ({e})")))?;
         State::named(&name, &text)
     }
 
@@ -329,7 +340,7 @@ impl Job {
         &self,
         cfg: &RunConfig,
         shard: Shard,
-        progress: &(dyn Fn(u64) + Sync),
+        progress: crate::runner::Progress,
     ) -> Result<State, Error> {
         let prepared = self.prepare()?;
         let est = prepared.estimator.as_ref().ok_or_else(|| {
@@ -368,14 +379,14 @@ impl Job {
 impl RenderJob {
     /// Renders shard `shard` of the image (its share of the rows) with
     /// `spp` paths per pixel from `seed` on `threads` threads, and returns
-    /// its state; `progress` is called with the shard's rows done.
+    /// its state; `progress` is called with the shard's pixels done.
     pub fn run_shard(
         &self,
         spp: u64,
         seed: u64,
         threads: usize,
         shard: Shard,
-        progress: &(dyn Fn(u64) + Sync),
+        progress: crate::runner::Progress,
     ) -> Result<State, Error> {
         let (est, canonical) = self.prepare()?;
         let Some((width, height)) = est.image() else {

@@ -209,6 +209,112 @@ fn a_peaked_phase_function_is_refused_by_the_expectation_method_only() {
     }
 }
 
+/// A named pipe as a scene, an OBJ or a state is refused at once: with
+/// no writer, `open` would block forever, without a word. A state path
+/// to an endless stream stops at its first byte.
+#[test]
+fn pipes_and_endless_states_are_refused_at_once() {
+    let dir = std::env::temp_dir().join(format!("geosens-adversarial-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = |name: &str| {
+        let path = dir.join(name);
+        let _ = std::fs::remove_file(&path);
+        let made = Command::new("mkfifo").arg(&path).status().unwrap();
+        assert!(made.success());
+        path
+    };
+    let scene = fifo("pipe.toml");
+    let args = flat(&scene, "intensity", "100");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    refused(&args, 1, &["pipe.toml", "named pipe"]);
+    fifo("pipe.obj");
+    let mesh = scene_file(
+        "pipe_mesh.toml",
+        "[sensor]\nkind = \"irradiance\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\
+         [[shapes]]\nname = \"lamp\"\nmesh = \"pipe.obj\"\n\
+         surface = { kind = \"emitter\", radiance = 1.0 }\n",
+    );
+    let m = mesh.to_str().unwrap();
+    refused(
+        &[
+            "mesh",
+            "--scene",
+            m,
+            "--method",
+            "intensity",
+            "--paths",
+            "100",
+        ],
+        1,
+        &["pipe.obj", "named pipe"],
+    );
+    let state = fifo("pipe.json");
+    refused(
+        &["merge", state.to_str().unwrap()],
+        1,
+        &["pipe.json", "named pipe"],
+    );
+    let zero = dir.join("zero_state.json");
+    let _ = std::fs::remove_file(&zero);
+    std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+    refused(
+        &["merge", zero.to_str().unwrap()],
+        1,
+        &["zero_state.json", "`{`"],
+    );
+}
+
+/// A file whose dimension its points do not tell (empty, a misspelt or
+/// short sensor point) gets the loader's own message, not advice to use
+/// the other command; a TOML syntax error gives its line.
+#[test]
+fn scene_faults_are_named_by_the_loader_with_their_line() {
+    let text = occluder(1.0, "");
+    let cases = [
+        ("empty.toml", String::new(), "missing field"),
+        (
+            "typo.toml",
+            text.replace("point = [0.0, 0.0]", "pointt = [0.0, 0.0]"),
+            "unknown field `pointt`",
+        ),
+        (
+            "short.toml",
+            text.replace("point = [0.0, 0.0]", "point = [0.0]"),
+            "invalid length 1",
+        ),
+        (
+            "syntax.toml",
+            text.replace("kind = \"irradiance\"", "kind = \"irradiance"),
+            "line 2",
+        ),
+    ];
+    for (name, body, needle) in cases {
+        let path = scene_file(name, &body);
+        let args = flat(&path, "intensity", "100");
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        refused(&args, 1, &[needle]);
+        let (_, _, err) = geosens(&args);
+        assert!(!err.contains("geosens mesh"), "{name}: {err}");
+    }
+    // A flatland file given to `mesh` with its sensor point misspelt is
+    // still told by its vertices.
+    let typo = scene_file(
+        "typo2.toml",
+        &text.replace("point = [0.0, 0.0]", "pointt = [0.0, 0.0]"),
+    );
+    refused(
+        &[
+            "mesh",
+            "--scene",
+            typo.to_str().unwrap(),
+            "--method",
+            "intensity",
+        ],
+        1,
+        &["flatland", "geosens flat"],
+    );
+}
+
 #[test]
 fn numbers_in_messages_are_short_and_flags_name_themselves() {
     refused(
@@ -229,6 +335,14 @@ fn numbers_in_messages_are_short_and_flags_name_themselves() {
         ],
         1,
         &["x = 3e300"],
+    );
+    refused(
+        &[
+            "rod", "--method", "fd", "--ks", "0", "--ke", "0", "--length", "1e308", "--x", "1e308",
+            "--omega", "-1",
+        ],
+        1,
+        &["x = 1e308"],
     );
     let path = scene_file("ok.toml", &occluder(1.0, ""));
     let p = path.to_str().unwrap();

@@ -94,10 +94,10 @@ fn every_pixel_matches_the_intervals() {
         .collect();
     assert!(derivatives[0].iter().filter(|d| d.abs() > 0.0).count() >= 2);
     let fd = scene.estimator(Method::Fd, None).unwrap();
-    let fd = render(fd.as_ref(), SPP, 3, 0, &|_| {}).unwrap();
+    let fd = render(fd.as_ref(), SPP, 3, 0, &geosens::runner::quiet).unwrap();
     for method in [Method::Rendering, Method::Transport, Method::Expectation] {
         let est = scene.estimator(method, None).unwrap();
-        let r = render(est.as_ref(), SPP, 4, 0, &|_| {}).unwrap();
+        let r = render(est.as_ref(), SPP, 4, 0, &geosens::runner::quiet).unwrap();
         assert_eq!((r.width, r.height), (WIDTH, 1));
         let mut checks = vec![(Quantity::Intensity, &exact)];
         for (par, d) in scene.parameters().iter().zip(&derivatives) {
@@ -189,8 +189,8 @@ fn finite_difference_images_count_their_jumps() {
     // jump). I carries no count.
     let scene = scene();
     let fd = scene.estimator(Method::Fd, None).unwrap();
-    let few = render(fd.as_ref(), 2, 3, 0, &|_| {}).unwrap();
-    let many = render(fd.as_ref(), SPP, 3, 0, &|_| {}).unwrap();
+    let few = render(fd.as_ref(), 2, 3, 0, &geosens::runner::quiet).unwrap();
+    let many = render(fd.as_ref(), SPP, 3, 0, &geosens::runner::quiet).unwrap();
     assert_eq!(many.mean(&Quantity::Intensity).unwrap().jumps, None);
     for par in scene.parameters() {
         let q = Quantity::sensitivity(&par.name);

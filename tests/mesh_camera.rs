@@ -32,7 +32,7 @@ const METHODS: [Method; 4] = [
 
 fn image(scene: &Arc<Scene>, method: Method, spp: u64, seed: u64) -> ImageResult {
     let est = scene.estimator(method, None).unwrap();
-    render(est.as_ref(), spp, seed, 0, &|_| {}).unwrap()
+    render(est.as_ref(), spp, seed, 0, &geosens::runner::quiet).unwrap()
 }
 
 fn floor_scene() -> Arc<Scene> {
@@ -362,8 +362,8 @@ fn images_are_identical_for_any_thread_count() {
     let scene = up_scene(8);
     for method in [Method::Expectation, Method::Fd] {
         let est = scene.estimator(method, None).unwrap();
-        let one = render(est.as_ref(), 16, 5, 1, &|_| {}).unwrap();
-        let two = render(est.as_ref(), 16, 5, 2, &|_| {}).unwrap();
+        let one = render(est.as_ref(), 16, 5, 1, &geosens::runner::quiet).unwrap();
+        let two = render(est.as_ref(), 16, 5, 2, &geosens::runner::quiet).unwrap();
         assert_eq!(one.images, two.images);
         assert_eq!(one.means, two.means);
     }
@@ -377,10 +377,10 @@ fn renders_refuse_what_they_cannot_do() {
             .unwrap(),
     );
     let est = probe.estimator(Method::Intensity, None).unwrap();
-    let e = render(est.as_ref(), 16, 1, 0, &|_| {}).unwrap_err();
+    let e = render(est.as_ref(), 16, 1, 0, &geosens::runner::quiet).unwrap_err();
     assert!(e.to_string().contains("not a camera"), "{e}");
     let scene = up_scene(4);
     let est = scene.estimator(Method::Rendering, None).unwrap();
-    let e = render(est.as_ref(), 1, 1, 0, &|_| {}).unwrap_err();
+    let e = render(est.as_ref(), 1, 1, 0, &geosens::runner::quiet).unwrap_err();
     assert!(e.to_string().contains("spp"), "{e}");
 }

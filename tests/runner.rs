@@ -2,6 +2,7 @@
 //! with the count (issue 11, item 1), the merge order must not depend on the
 //! thread count or the batching, and counts that are not exact in f64 are
 //! refused with a message.
+use geosens::Error;
 use geosens::estimator::{Estimator, Quantity};
 use geosens::rng::{self, PathRng};
 use geosens::runner::{BLOCK, CHUNK, RunConfig, run, run_with_progress};
@@ -90,11 +91,37 @@ fn progress_counts_every_path_and_changes_no_bit() {
             assert!(done <= paths, "{done} of {paths}");
             calls.fetch_add(1, Ordering::Relaxed);
             last.fetch_max(done, Ordering::Relaxed);
+            Ok(())
         })
         .unwrap();
         assert_eq!(with.estimates, run(&Cheap, &cfg).unwrap().estimates);
         assert_eq!(calls.into_inner(), paths.div_ceil(CHUNK));
         assert_eq!(last.into_inner(), paths);
+    }
+}
+
+/// A progress hook's error stops the run soon after (each worker ends the
+/// chunk it is on) and is what the run returns: a run of 2⁵³ paths, years
+/// long, stopped at its fifth chunk, on one thread and on three.
+#[test]
+fn a_progress_hook_stops_a_run_with_its_error() {
+    for threads in [1, 3] {
+        let cfg = RunConfig::new(1 << 53, 1).unwrap().threads(threads);
+        let calls = AtomicU64::new(0);
+        let e = run_with_progress(&Cheap, &cfg, &|_| {
+            if calls.fetch_add(1, Ordering::Relaxed) + 1 >= 5 {
+                Err(Error::Stopped("enough".into()))
+            } else {
+                Ok(())
+            }
+        })
+        .unwrap_err();
+        assert_eq!(e, Error::Stopped("enough".into()));
+        // One thread stops at once; on three, the chunks under way (or
+        // started in the instant before the stop was recorded) end first.
+        let calls = calls.into_inner();
+        let most = if threads == 1 { 5 } else { 100 };
+        assert!((5..=most).contains(&calls), "{calls} chunks");
     }
 }
 

@@ -251,11 +251,11 @@ fn the_library_merges_as_the_cli_does() {
         fd_step: None,
     };
     let cfg = RunConfig::new(200_000, 11).unwrap().threads(2);
-    let single = job.run(&cfg, &|_| {}).unwrap();
+    let single = job.run(&cfg, &geosens::runner::quiet).unwrap();
     let states: Vec<(String, State)> = (1..=3)
         .map(|i| {
             let s = job
-                .run_shard(&cfg, Shard::new(i, 3).unwrap(), &|_| {})
+                .run_shard(&cfg, Shard::new(i, 3).unwrap(), &geosens::runner::quiet)
                 .unwrap();
             // Through the file format and back.
             let s = State::from_json(&s.to_json().unwrap()).unwrap();

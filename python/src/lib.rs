@@ -5,16 +5,20 @@
 //! shard's state), which `geosens/__init__.py` turns into Python objects;
 //! every bad input raises `ValueError` with the library's message, the one
 //! the command line prints after `error: `. The GIL is released while
-//! sampling.
+//! sampling, and Ctrl-C stops a run (`KeyboardInterrupt`).
 use geosens::image::ImageResult;
 use geosens::job::{ImageReport, Job, RenderJob, SceneSource, Target};
 use geosens::report::Report;
+use geosens::runner::Progress;
 use geosens::shard::{Merged, Shard, State, merge as merge_states};
 use geosens::{Error, Method, Quantity, RunConfig};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::Duration;
 
 /// One image of a rendering as Python gets it: its key (`I`, or the
 /// parameter's name), height, width, and the bytes of its means and standard
@@ -87,8 +91,62 @@ fn source(path: Option<PathBuf>, json: Option<String>) -> PyResult<SceneSource> 
     }
 }
 
+/// Runs `work` on a thread of its own while the caller's (Python's main)
+/// thread, the GIL released, looks for signals every 50 ms: Python runs its
+/// signal handlers only there, and only between bytecodes. On Ctrl-C the
+/// run stops at its next chunk (or row) through its progress hook, and the
+/// handler's exception (`KeyboardInterrupt`) is raised here once the
+/// chunks under way have ended.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(Progress) -> Result<T, Error> + Send,
+) -> PyResult<Result<T, Error>> {
+    let stop = AtomicBool::new(false);
+    let hook = |_done: u64| {
+        if stop.load(Ordering::Relaxed) {
+            Err(Error::Stopped("interrupted".into()))
+        } else {
+            Ok(())
+        }
+    };
+    let hook = &hook;
+    std::thread::scope(|s| {
+        let (tx, rx) = mpsc::channel();
+        // The stack of a main thread: a run on one thread runs here.
+        let worker = std::thread::Builder::new()
+            .stack_size(8 << 20)
+            .spawn_scoped(s, move || {
+                let out = work(hook);
+                let _ = tx.send(());
+                out
+            })
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot start the run's thread: {e}")))?;
+        let (mut signal, mut rx) = (None, rx);
+        loop {
+            // The receiver goes to the GIL-free side and back (it is Send,
+            // not Sync).
+            let (waited, back) =
+                py.detach(move || (rx.recv_timeout(Duration::from_millis(50)), rx));
+            rx = back;
+            if waited != Err(mpsc::RecvTimeoutError::Timeout) {
+                break;
+            }
+            if signal.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                stop.store(true, Ordering::Relaxed);
+                signal = Some(e);
+            }
+        }
+        let out = py
+            .detach(|| worker.join())
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        signal.map_or(Ok(out), Err)
+    })
+}
+
 /// Runs `job` on `paths` paths, or its shard `shard = (i, n)`, without the
-/// GIL.
+/// GIL, stopping at Ctrl-C ([`interruptible`]).
 fn estimate(
     py: Python<'_>,
     job: Job,
@@ -97,15 +155,15 @@ fn estimate(
     threads: usize,
     shard: Option<(u64, u64)>,
 ) -> PyResult<Outcome> {
-    let out = py.detach(|| -> Result<Output, Error> {
+    let out = interruptible(py, |progress| -> Result<Output, Error> {
         let cfg = RunConfig::new(paths, seed)?.threads(threads);
         match shard {
-            None => job.run(&cfg, &|_| {}).map(Output::Report),
+            None => job.run(&cfg, progress).map(Output::Report),
             Some((i, n)) => job
-                .run_shard(&cfg, Shard::new(i, n)?, &|_| {})
+                .run_shard(&cfg, Shard::new(i, n)?, progress)
                 .map(Output::State),
         }
-    });
+    })?;
     out.and_then(|o| o.into_py(py)).map_err(value_error)
 }
 
@@ -197,15 +255,15 @@ fn render(
         method,
         fd_step,
     };
-    let out = py.detach(|| -> Result<Output, Error> {
+    let out = interruptible(py, |progress| -> Result<Output, Error> {
         geosens::runner::check_threads(threads)?;
         match shard {
-            None => job.run(spp, seed, threads, &|_| {}).map(Output::Image),
+            None => job.run(spp, seed, threads, progress).map(Output::Image),
             Some((i, n)) => job
-                .run_shard(spp, seed, threads, Shard::new(i, n)?, &|_| {})
+                .run_shard(spp, seed, threads, Shard::new(i, n)?, progress)
                 .map(Output::State),
         }
-    });
+    })?;
     out.and_then(|o| o.into_py(py)).map_err(value_error)
 }
 

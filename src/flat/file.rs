@@ -69,14 +69,14 @@ pub fn load(path: &Path) -> Result<Scene, Error> {
     parse_file(path, from_toml, from_json)
 }
 
-/// The dimension of the scene file at `path`: 2 if its sensor's point
-/// (`point` or `position`) has two coordinates (a flatland file), else 3
-/// (the 3D loader then says what is wrong). Errors only if the file cannot
-/// be read or parsed at all.
-pub fn dimension(path: &Path) -> Result<usize, Error> {
+/// The dimension of the scene file at `path` ([`dimension_of`]: `None`
+/// when the file does not say, and the loader must tell what is wrong).
+/// Errors only if the file cannot be read or parsed at all, with the
+/// parser's line and column.
+pub fn dimension(path: &Path) -> Result<Option<usize>, Error> {
     fn as_json(text: &str) -> Result<serde_json::Value, Error> {
         let value: toml::Value =
-            toml::from_str(text).map_err(|e| Error::Scene(e.message().to_owned()))?;
+            toml::from_str(text).map_err(|e| Error::Scene(e.to_string().trim_end().to_string()))?;
         serde_json::to_value(value).map_err(|e| Error::Scene(e.to_string()))
     }
     fn from_json_text(text: &str) -> Result<serde_json::Value, Error> {
@@ -86,19 +86,23 @@ pub fn dimension(path: &Path) -> Result<usize, Error> {
 }
 
 /// The dimension of a scene given as the file's schema in JSON (a parsed
-/// file, or a Python dict): 2 if its sensor's point has two coordinates,
-/// else 3.
-pub fn dimension_of(value: &serde_json::Value) -> usize {
+/// file, or a Python dict): the number of coordinates of its sensor's
+/// point (`point`, or a camera's `position`), or failing that of the first
+/// shape's first vertex, if 2 or 3; `None` if neither says (no sensor, a
+/// misspelt key, a point of one coordinate: the loader of either dimension
+/// names the fault).
+pub fn dimension_of(value: &serde_json::Value) -> Option<usize> {
     let sensor = &value["sensor"];
     let point = if sensor["point"].is_array() {
         &sensor["point"]
     } else {
         &sensor["position"]
     };
-    match point.as_array() {
-        Some(a) if a.len() == 2 => 2,
-        _ => 3,
-    }
+    let vertex = &value["shapes"][0]["vertices"][0];
+    [point, vertex]
+        .iter()
+        .filter_map(|p| p.as_array().map(Vec::len))
+        .find(|n| (2..=3).contains(n))
 }
 
 /// `e` with the file `path` named in its message (scene errors only).
@@ -143,14 +147,8 @@ pub const MAX_SCENE_BYTES: u64 = 256 << 20;
 
 /// The text of the file at `path`, at most [`MAX_SCENE_BYTES`] long.
 pub(crate) fn read_capped(path: &Path) -> Result<String, Error> {
-    let bytes = read_bytes_capped(path).map_err(|why| match why {
-        Unread::Io(e) => Error::Scene(format!("cannot read scene file {}: {e}", path.display())),
-        Unread::TooLarge => Error::Scene(format!(
-            "scene file {} is larger than {} MiB (or an endless stream): not read",
-            path.display(),
-            MAX_SCENE_BYTES >> 20
-        )),
-    })?;
+    let bytes = read_bytes_capped(path, MAX_SCENE_BYTES, None)
+        .map_err(|why| Error::Scene(format!("cannot read scene file {}: {why}", path.display())))?;
     String::from_utf8(bytes).map_err(|e| {
         Error::Scene(format!(
             "cannot read scene file {}: not UTF-8 text ({e})",
@@ -159,25 +157,87 @@ pub(crate) fn read_capped(path: &Path) -> Result<String, Error> {
     })
 }
 
-/// Why [`read_bytes_capped`] read nothing.
+/// Why [`read_bytes_capped`] read nothing; `Display` says it in words for
+/// the caller's "cannot read FILE: …".
+#[derive(Debug)]
 pub(crate) enum Unread {
     /// The file could not be opened or read.
     Io(std::io::Error),
-    /// It holds more than [`MAX_SCENE_BYTES`].
-    TooLarge,
+    /// It holds more than the cap, in bytes.
+    TooLarge(u64),
+    /// It is a named pipe or a socket: opening or reading it waits for a
+    /// writer that may never come or never close it, silently.
+    Pipe,
+    /// Its first byte past white space is not the one its format starts
+    /// with (a stream of zeros, say: refused before the cap is read).
+    Lead(u8),
 }
 
-/// The bytes of the file at `path`, at most [`MAX_SCENE_BYTES`] (scene
-/// files here, OBJ meshes in `mesh::file`).
-pub(crate) fn read_bytes_capped(path: &Path) -> Result<Vec<u8>, Unread> {
+impl std::fmt::Display for Unread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Unread::Io(e) => write!(f, "{e}"),
+            Unread::TooLarge(cap) => write!(
+                f,
+                "larger than {} MiB (or an endless stream): not read",
+                cap >> 20
+            ),
+            Unread::Pipe => write!(
+                f,
+                "a named pipe, not a file: not read (its writer may never open or close it; \
+                 save what it carries to a file)"
+            ),
+            Unread::Lead(b) => write!(
+                f,
+                "not in the expected format (its text does not start with `{}`)",
+                char::from(*b)
+            ),
+        }
+    }
+}
+
+/// The bytes of the file at `path`, at most `cap` (scene files here, OBJ
+/// meshes in `mesh::file`, shard states in `shard`), whose first byte
+/// past white space is `lead` if given. A pipe is refused before it is
+/// opened: `open` itself blocks until a writer comes.
+pub(crate) fn read_bytes_capped(
+    path: &Path,
+    cap: u64,
+    lead: Option<u8>,
+) -> Result<Vec<u8>, Unread> {
     use std::io::Read;
-    let file = std::fs::File::open(path).map_err(Unread::Io)?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = std::fs::metadata(path).map_err(Unread::Io)?.file_type();
+        if kind.is_fifo() || kind.is_socket() {
+            return Err(Unread::Pipe);
+        }
+    }
+    let mut file = std::fs::File::open(path).map_err(Unread::Io)?.take(cap + 1);
     let mut bytes = Vec::new();
-    file.take(MAX_SCENE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(Unread::Io)?;
-    if bytes.len() as u64 > MAX_SCENE_BYTES {
-        return Err(Unread::TooLarge);
+    if let Some(want) = lead {
+        let mut byte = [0u8];
+        loop {
+            match file.read(&mut byte) {
+                Ok(0) => break,
+                Ok(_) => {
+                    bytes.push(byte[0]);
+                    if !byte[0].is_ascii_whitespace() {
+                        if byte[0] != want {
+                            return Err(Unread::Lead(want));
+                        }
+                        break;
+                    }
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(Unread::Io(e)),
+            }
+        }
+    }
+    file.read_to_end(&mut bytes).map_err(Unread::Io)?;
+    if bytes.len() as u64 > cap {
+        return Err(Unread::TooLarge(cap));
     }
     Ok(bytes)
 }

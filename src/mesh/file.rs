@@ -46,9 +46,7 @@
 //! relative to the current directory.
 use super::scene::{Medium, Parameter, Scene, Sensor, Shape, Surface};
 use crate::error::Error;
-use crate::flat::file::{
-    MAX_SCENE_BYTES, Unread, in_file, json_error, parse_file, read_bytes_capped,
-};
+use crate::flat::file::{MAX_SCENE_BYTES, in_file, json_error, parse_file, read_bytes_capped};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -222,13 +220,8 @@ fn read_obj(path: &Path, name: &str) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), Erro
             path.display()
         ))
     };
-    let bytes = read_bytes_capped(path).map_err(|why| match why {
-        Unread::Io(e) => fail(e.to_string()),
-        Unread::TooLarge => fail(format!(
-            "larger than {} MiB (or an endless stream)",
-            MAX_SCENE_BYTES >> 20
-        )),
-    })?;
+    let bytes =
+        read_bytes_capped(path, MAX_SCENE_BYTES, None).map_err(|why| fail(why.to_string()))?;
     let options = tobj::LoadOptions {
         triangulate: true,
         ignore_points: true,

@@ -247,7 +247,7 @@ pub fn finite_difference(rod: Rod, probe: Probe, step: f64) -> Result<CentralDif
         return Err(Error::Scene(format!(
             "finite differences in the length need the probe inside the rod \
              (x < length): at x = {} no shortened rod contains it",
-            probe.x
+            crate::error::Num(probe.x)
         )));
     }
     let h = step * rod.length;

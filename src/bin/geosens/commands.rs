@@ -1,6 +1,6 @@
 //! The subcommands: `rod`, `compare` and `flat`, each printing a table or
 //! one JSON line.
-use super::output::progress_bar;
+use super::output::{progress_bar, shown};
 use super::*;
 use geosens::report::{RodProbe, yes_no, z_text};
 use geosens::shard::Merged;
@@ -45,7 +45,7 @@ fn estimate(
             "paths",
             job.method.map_or("exact", Method::name).to_owned(),
         );
-        let report = job.run(&cfg, &|done| bar.set_position(done));
+        let report = job.run(&cfg, &shown(&bar));
         bar.finish_and_clear();
         return print_report(&report?, json, out);
     };
@@ -63,7 +63,7 @@ fn estimate(
         "paths",
         format!("{} shard {which}", job.method.map_or("exact", Method::name)),
     );
-    let state = job.run_shard(&cfg, which, &|done| bar.set_position(done));
+    let state = job.run_shard(&cfg, which, &shown(&bar));
     bar.finish_and_clear();
     let state = state?;
     state.write(path)?;

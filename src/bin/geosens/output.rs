@@ -39,7 +39,7 @@ pub(super) fn writable_file(path: &Path) -> Result<(), Error> {
 }
 
 /// A progress bar on stderr for `len` units of work (`unit`: "paths",
-/// "rows"), drawn only where stderr is a terminal (indicatif's own check):
+/// "pixels"), drawn only where stderr is a terminal (indicatif's own check):
 /// a long run in a terminal shows it is alive and when it will end, and a
 /// script's or a cluster job's stderr stays clean.
 pub(super) fn progress_bar(len: u64, unit: &str, msg: String) -> indicatif::ProgressBar {
@@ -50,4 +50,12 @@ pub(super) fn progress_bar(len: u64, unit: &str, msg: String) -> indicatif::Prog
     }
     bar.set_message(msg);
     bar
+}
+
+/// The progress hook that moves `bar` and never stops the run.
+pub(super) fn shown(bar: &indicatif::ProgressBar) -> impl Fn(u64) -> Result<(), Error> + Sync + '_ {
+    move |done| {
+        bar.set_position(done);
+        Ok(())
+    }
 }

@@ -128,7 +128,13 @@ pub(super) fn render_command(
         }
         super::output::writable_file(path)?;
         let which = args.shard.shard.unwrap_or(Shard::WHOLE);
-        let state = job.run_shard(args.spp, args.seed, args.threads, which, &|_| {})?;
+        let state = job.run_shard(
+            args.spp,
+            args.seed,
+            args.threads,
+            which,
+            &geosens::runner::quiet,
+        )?;
         state.write(path)?;
         eprintln!(
             "wrote shard {which} ({} paths) to {}",
@@ -146,18 +152,17 @@ pub(super) fn render_command(
     let dir = args.out.as_deref().ok_or("--out DIR is needed")?;
     let (estimator, _) = job.prepare()?;
     super::output::writable_dir(dir)?;
-    let rows = estimator.image().map_or(0, |(_, h)| h);
-    let bar = super::output::progress_bar(
-        u64::from(rows),
-        "rows",
-        format!("render {}", estimator.method()),
-    );
+    let pixels = estimator
+        .image()
+        .map_or(0, |(w, h)| u64::from(w) * u64::from(h));
+    let bar =
+        super::output::progress_bar(pixels, "pixels", format!("render {}", estimator.method()));
     let result = render(
         estimator.as_ref(),
         args.spp,
         args.seed,
         args.threads,
-        &|done| bar.set_position(done),
+        &super::output::shown(&bar),
     );
     bar.finish_and_clear();
     let report = ImageReport {

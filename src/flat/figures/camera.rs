@@ -62,7 +62,13 @@ pub fn camera(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         let est = scene.estimator(m, None)?;
         runs.push((
             m,
-            render(est.as_ref(), spp, opts.seed, opts.threads, &|_| {})?,
+            render(
+                est.as_ref(),
+                spp,
+                opts.seed,
+                opts.threads,
+                &crate::runner::quiet,
+            )?,
         ));
     }
     let mut panels = Vec::new();

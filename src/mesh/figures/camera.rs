@@ -52,14 +52,17 @@ pub fn render_all(opts: &FigureOptions, scene: &Arc<Scene>) -> Result<Vec<ImageR
         .iter()
         .map(|&method| {
             let est = scene.estimator(method, None)?;
-            let rows = est.image().map_or(0, |(_, h)| u64::from(h));
-            let bar = opts.bar(rows, &format!("camera: {}", method.name()));
+            let pixels = est.image().map_or(0, |(w, h)| u64::from(w) * u64::from(h));
+            let bar = opts.bar(pixels, &format!("camera: {}", method.name()));
             let image = render(
                 est.as_ref(),
                 opts.paths(SPP),
                 opts.seed,
                 opts.threads,
-                &|done| bar.set_position(done),
+                &|done| {
+                    bar.set_position(done);
+                    Ok(())
+                },
             );
             bar.finish_and_clear();
             image
