@@ -94,7 +94,7 @@ fn source(path: Option<PathBuf>, json: Option<String>) -> PyResult<SceneSource> 
 /// Runs `work` on a thread of its own while the caller's (Python's main)
 /// thread, the GIL released, looks for signals every 50 ms: Python runs its
 /// signal handlers only there, and only between bytecodes. On Ctrl-C the
-/// run stops at its next chunk (or row) through its progress hook, and the
+/// run stops at its next chunk (a rendering's: pixel) through its progress hook, and the
 /// handler's exception (`KeyboardInterrupt`) is raised here once the
 /// chunks under way have ended.
 fn interruptible<T: Send>(

@@ -48,5 +48,5 @@ def test_ctrl_c_stops_a_run(name):
     )
     assert out.returncode == 0, f"{name}: {out.stdout} {out.stderr}"
     seconds = float(out.stdout.split()[2])
-    # The signal at 1 s; the run stops after the chunk (or row) under way.
+    # The signal at 1 s; the run stops after the chunk (or pixel) under way.
     assert seconds < 10, f"{name}: {out.stdout}"

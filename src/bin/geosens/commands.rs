@@ -33,6 +33,7 @@ fn estimate(
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let cfg = run.config(1_000_000)?;
+    let method = job.method.map_or("exact", Method::name);
     let Some(path) = &shard.state else {
         if let Some(s) = shard.shard {
             return Err(Error::Config(format!(
@@ -40,11 +41,7 @@ fn estimate(
             ))
             .into());
         }
-        let bar = progress_bar(
-            cfg.paths,
-            "paths",
-            job.method.map_or("exact", Method::name).to_owned(),
-        );
+        let bar = progress_bar(cfg.paths, "paths", method.to_owned());
         let report = job.run(&cfg, &shown(&bar));
         bar.finish_and_clear();
         return print_report(&report?, json, out);
@@ -61,7 +58,7 @@ fn estimate(
     let bar = progress_bar(
         which.paths(cfg.paths),
         "paths",
-        format!("{} shard {which}", job.method.map_or("exact", Method::name)),
+        format!("{method} shard {which}"),
     );
     let state = job.run_shard(&cfg, which, &shown(&bar));
     bar.finish_and_clear();

@@ -172,7 +172,7 @@ fn self_contact(s: &Shape, i: usize, j: usize, tol: f64) -> Option<&'static str>
             let cj = pj[m];
             let n = (b - a).cross(ci - a);
             let off = n.dot(cj - a) / n.length();
-            let same_side = (b - a).cross(ci - a).dot((b - a).cross(cj - a)) > 0.0;
+            let same_side = n.dot((b - a).cross(cj - a)) > 0.0;
             (off.abs() <= tol && same_side).then_some("folds onto itself along an edge")
         }
         _ => None,
