@@ -454,3 +454,52 @@ fn transport_with_and_without_twins_agrees() {
     let copy = walked.get(&Quantity::sensitivity("wedge_tx_129")).unwrap();
     assert_eq!(first.mean, copy.mean);
 }
+
+/// A radiance sensor's ray that meets an absorbing polygon exactly at a
+/// corner and only touches it stays outside: `I` is the lamp's radiance,
+/// `e⁰ = 1`, by every method (the walk had counted the touch as entering
+/// and read `e^{−2·1}` ± 0, reliable). A ray that leaves through a corner
+/// still reads `e^{−κe ℓ}`, chord `ℓ = 0.3`; one that enters and leaves
+/// through corners (a diamond's), `ℓ = 0.6`.
+#[test]
+fn a_sensor_ray_touching_a_medium_at_a_corner_stays_outside() {
+    let cases = [
+        ("[[0.0, 1.0], [0.5, 0.7], [0.6, 1.5]]", 1.0),
+        (
+            "[[-0.3, 0.7], [0.0, 1.0], [0.3, 0.7]]",
+            (-2.0f64 * 0.3).exp(),
+        ),
+        (
+            "[[0.0, 0.7], [0.3, 1.0], [0.0, 1.3], [-0.3, 1.0]]",
+            (-2.0f64 * 0.6).exp(),
+        ),
+    ];
+    for (k, (vertices, exact)) in cases.iter().enumerate() {
+        let text = format!(
+            "[sensor]\nkind = \"radiance\"\npoint = [0.0, 0.0]\ndirection = [0.0, 1.0]\n\
+             [[shapes]]\nname = \"lamp\"\nvertices = [[-1.0, 2.0], [1.0, 2.0]]\n\
+             surface = {{ kind = \"emitter\", radiance = 1.0 }}\n\
+             [[shapes]]\nname = \"fog\"\nclosed = true\nvertices = {vertices}\n\
+             surface = {{ kind = \"transparent\" }}\nmedium = {{ ks = 0.0, ke = 2.0 }}\n\
+             [[parameters]]\nname = \"fog_ty\"\nshape = \"fog\"\n\
+             motion = {{ kind = \"translate_y\" }}\n"
+        );
+        let scene = Arc::new(file::from_toml(&text).unwrap());
+        for m in [
+            Method::Intensity,
+            Method::Expectation,
+            Method::Rendering,
+            Method::Transport,
+        ] {
+            let e = m.estimator(Arc::clone(&scene)).unwrap();
+            let r = run(e.as_ref(), &RunConfig::new(2000, 4).unwrap()).unwrap();
+            let i = r.get(&Quantity::Intensity).unwrap();
+            assert!(
+                (i.mean - exact).abs() < 1e-9 * exact,
+                "case {k}, {m}: I = {} ± {}, exact {exact}",
+                i.mean,
+                i.stderr
+            );
+        }
+    }
+}

@@ -1477,3 +1477,93 @@ surface = {{ kind = "reflector", albedo = 0.8 }}
             .any(|(q, _)| *q == Quantity::gradient("z"))
     );
 }
+
+/// A radiance sensor's ray that meets an absorbing medium's closed
+/// boundary exactly at an edge or a vertex and only touches it stays
+/// outside: `I` is the lamp's radiance, `e⁰ = 1`, by every method (the
+/// walk had counted the touch as entering and read `e^{−κe·1}` ± 0,
+/// reliable). A ray that crosses the boundary through edges (a cube's face
+/// diagonals) and through a vertex still reads `e^{−κe ℓ}` with the chord
+/// `ℓ` of the geometry. Each ray is the sensor's, so every path repeats it.
+#[test]
+fn a_sensor_ray_touching_a_medium_at_an_edge_or_vertex_stays_outside() {
+    let lamp = r#"
+[[shapes]]
+name = "lamp"
+vertices = [[-2.0, -2.0, 2.0], [2.0, -2.0, 2.0], [2.0, 2.0, 2.0], [-2.0, 2.0, 2.0]]
+triangles = [[0, 1, 2], [0, 2, 3]]
+surface = { kind = "emitter", radiance = 1.0 }
+"#;
+    let tetra = |vertices: &str| {
+        format!(
+            "[[shapes]]\nname = \"fog\"\nvertices = {vertices}\n\
+             triangles = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]\n\
+             surface = {{ kind = \"transparent\" }}\nmedium = {{ ks = 0.0, ke = 2.0 }}\n"
+        )
+    };
+    let cube = "[[shapes]]\nname = \"fog\"\n\
+        vertices = [[-0.4, -0.4, 0.6], [0.4, -0.4, 0.6], [-0.4, 0.4, 0.6], [0.4, 0.4, 0.6], \
+        [-0.4, -0.4, 1.4], [0.4, -0.4, 1.4], [-0.4, 0.4, 1.4], [0.4, 0.4, 1.4]]\n\
+        triangles = [[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4], \
+        [2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5]]\n\
+        surface = { kind = \"transparent\" }\nmedium = { ks = 0.0, ke = 1.5 }\n";
+    let sensor = |point: &str, direction: &str| {
+        format!("[sensor]\nkind = \"radiance\"\npoint = {point}\ndirection = {direction}\n")
+    };
+    let motion = "[[parameters]]\nname = \"fog_tz\"\nshape = \"fog\"\n\
+                  motion = { kind = \"translate_z\" }\n";
+    let cases = [
+        // Along z, touching the edge (0, ±0.25, 1) from outside.
+        (
+            sensor("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]"),
+            tetra("[[0.0, -0.25, 1.0], [0.0, 0.25, 1.0], [0.5, 0.0, 0.75], [0.5, 0.0, 1.5]]"),
+            1.0,
+        ),
+        // Along z, touching the vertex (0, 0, 1) only.
+        (
+            sensor("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]"),
+            tetra("[[0.0, 0.0, 1.0], [0.5, -0.25, 1.0], [0.5, 0.25, 0.9], [0.6, 0.0, 1.4]]"),
+            1.0,
+        ),
+        // At 45°, grazing the cube's edge x = 0.4, z = 0.6 (the direction's
+        // rounding puts the ray a hair inside one face).
+        (
+            sensor("[0.2, 0.0, 0.4]", "[1.0, 0.0, 1.0]"),
+            cube.to_string(),
+            1.0,
+        ),
+        // Through the cube along z: in and out through the faces' shared
+        // diagonals, chord 0.8.
+        (
+            sensor("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]"),
+            cube.to_string(),
+            (-1.5f64 * 0.8).exp(),
+        ),
+        // Through the cube's corners (−0.4, −0.4, 0.6) and (0.4, 0.4, 1.4):
+        // chord 0.8·√3.
+        (
+            sensor("[-0.6, -0.6, 0.4]", "[1.0, 1.0, 1.0]"),
+            cube.to_string(),
+            (-1.5f64 * 0.8 * 3f64.sqrt()).exp(),
+        ),
+    ];
+    for (k, (sensor, fog, exact)) in cases.iter().enumerate() {
+        let text = format!("{sensor}{lamp}{fog}{motion}");
+        let scene = Arc::new(geosens::mesh::file::from_toml(&text).unwrap());
+        for m in [
+            Method::Intensity,
+            Method::Expectation,
+            Method::Rendering,
+            Method::Transport,
+        ] {
+            let r = estimate(&scene, m, 2000, 4);
+            let i = r.get(&Quantity::Intensity).unwrap();
+            assert!(
+                (i.mean - exact).abs() < 1e-9 * exact,
+                "case {k}, {m}: I = {} ± {}, exact {exact}",
+                i.mean,
+                i.stderr
+            );
+        }
+    }
+}

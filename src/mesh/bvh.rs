@@ -104,6 +104,14 @@ pub fn intersect(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<f64> {
     Shear::new(origin, dir).hit(tri, nearest_hit2(tri))
 }
 
+/// The three edge functions of [`intersect`]'s test for the ray from
+/// `origin` along `dir`, the numbers it compares with 0: the `i`-th
+/// belongs to the edge opposite `tri[i]`. A hit with one of them exactly 0
+/// lies on that edge, with two at the vertex they share.
+pub fn edge_functions(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> [f64; 3] {
+    Shear::new(origin, dir).edges(tri).0
+}
+
 /// The square of the least distance (times `|dir|`) at which a ray hits
 /// `tri`: [`T_MIN`] times its longest edge, and at least `ROUNDING_ULPS`
 /// ulps of its largest coordinate (far from the origin the rounding of a
@@ -178,9 +186,10 @@ impl Shear {
         (p.dot(self.ex), p.dot(self.ey), p.dot(self.ez))
     }
 
-    /// The test of [`intersect`], `min2` the triangle's [`nearest_hit2`].
+    /// The edge functions of `tri` (see [`edge_functions`]) and the ray
+    /// parameters of its vertices' planes across the ray.
     #[inline(always)]
-    fn hit(&self, tri: &[DVec3; 3], min2: f64) -> Option<f64> {
+    fn edges(&self, tri: &[DVec3; 3]) -> ([f64; 3], [f64; 3]) {
         let (ax, ay, az) = self.project(tri[0]);
         let (bx, by, bz) = self.project(tri[1]);
         let (cx, cy, cz) = self.project(tri[2]);
@@ -189,6 +198,13 @@ impl Shear {
         let u = cx * by - cy * bx;
         let v = ax * cy - ay * cx;
         let w = bx * ay - by * ax;
+        ([u, v, w], [az, bz, cz])
+    }
+
+    /// The test of [`intersect`], `min2` the triangle's [`nearest_hit2`].
+    #[inline(always)]
+    fn hit(&self, tri: &[DVec3; 3], min2: f64) -> Option<f64> {
+        let ([u, v, w], [az, bz, cz]) = self.edges(tri);
         let inside = (u >= 0.0 && v >= 0.0 && w >= 0.0) || (u <= 0.0 && v <= 0.0 && w <= 0.0);
         if !inside {
             return None;

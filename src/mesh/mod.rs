@@ -31,6 +31,7 @@ mod obj_lines;
 pub mod scene;
 pub mod sensor_view;
 pub mod space;
+mod touch;
 pub mod warp;
 
 pub use scene::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};

@@ -36,6 +36,10 @@ pub struct Edge {
     pub shape: u32,
 }
 
+/// Most edge or vertex touches of media boundaries one cast passes
+/// (`Space::touches_only`) before it reports the next hit as it is.
+const MAX_TOUCHES: usize = 8;
+
 /// A 3D scene with the tables the estimators need.
 #[derive(Debug, Clone)]
 pub struct Space {
@@ -46,7 +50,7 @@ pub struct Space {
     pub(super) owner: Vec<u32>,
     /// Unit normal of each triangle, outward for closed meshes.
     pub(super) normals: Vec<DVec3>,
-    caster: TriangleBvh,
+    pub(super) caster: TriangleBvh,
     /// Opaque triangles only (visibility), the map from a triangle to its
     /// index there.
     opaque: TriangleBvh,
@@ -465,9 +469,27 @@ impl Geometry for Space {
     }
     #[inline]
     fn cast(&self, x: DVec3, w: DVec3, skip: Prim) -> Option<Hit> {
+        // A medium's boundary only touched at an edge or a vertex is passed
+        // (`touch`), a few times at most.
+        let (mut from, mut skip, mut before) = (x, skip, 0.0);
+        for _ in 0..MAX_TOUCHES {
+            let (t, prim) = self.caster.closest_hit(from, w, f64::INFINITY, skip)?;
+            if self.surface(prim) != Surface::Transparent || !self.touches_only(from, w, prim, t) {
+                return Some(Hit {
+                    t: before + t,
+                    prim,
+                });
+            }
+            before += t;
+            from += w * t;
+            skip = prim;
+        }
         self.caster
-            .closest_hit(x, w, f64::INFINITY, skip)
-            .map(|(t, prim)| Hit { t, prim })
+            .closest_hit(from, w, f64::INFINITY, skip)
+            .map(|(t, prim)| Hit {
+                t: before + t,
+                prim,
+            })
     }
     #[inline]
     fn visible(&self, x: DVec3, y: DVec3, skip: Prim) -> bool {

@@ -16,6 +16,7 @@ use serde::{Deserialize, Serialize};
 mod repr;
 #[cfg(test)]
 mod tests;
+mod touch;
 mod validate;
 
 pub(crate) use validate::check_extent;
@@ -339,11 +340,6 @@ impl Scene {
     #[inline]
     pub fn parameter_shape(&self, j: usize) -> u32 {
         self.parameter_shape[j]
-    }
-    /// Closest segment along a ray (any surface).
-    #[inline]
-    pub fn cast(&self, origin: DVec2, dir: DVec2, skip: u32) -> Option<super::geometry::Hit> {
-        self.caster.closest_hit(origin, dir, f64::INFINITY, skip)
     }
     /// Whether no opaque segment (other than `skip`) lies strictly between
     /// `from` and `to`.
