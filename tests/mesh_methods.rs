@@ -1567,3 +1567,66 @@ surface = { kind = "emitter", radiance = 1.0 }
         }
     }
 }
+
+/// Shadow edges 10⁻⁴ inside and outside the lamp's edges: the default
+/// step of the finite differences carries them across, so the quotient
+/// straddles the kinks where the shadow's edges start or stop cutting the
+/// lamp (a campaign's occluder, one edge 10⁻⁴ inside: −0.1477 ± 0.0069
+/// against the closed form's −0.0206, marked reliable; here 0.028 ± 0.010
+/// against 0.386). The caveat says so. A step that stays on one side
+/// carries none and matches the closed form; nor does the shipped
+/// occluder, whose shadow edges lie far from the lamp's, get one.
+#[test]
+fn a_step_across_a_shadow_edge_reaching_the_lamps_is_a_caveat_for_finite_differences() {
+    use geosens::mesh::exact::OccluderScene;
+    // Left shadow edge at 2 (cx − 0.25) = −0.4999; the others far inside
+    // or outside the lamp.
+    let o = OccluderScene::shipped(0.00005, 0.05);
+    let occ = Shape {
+        name: "occ".into(),
+        vertices: o.occluder().to_vec(),
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+        surface: Surface::Absorber,
+        medium: None,
+    };
+    let exact = o.sensitivities().unwrap()[0];
+    let scene = Arc::new(
+        Scene::new(
+            vec![lamp(), occ],
+            params("occ", &[("tx", Motion::TranslateX)]),
+            up(),
+        )
+        .unwrap(),
+    );
+    let fd = |step: f64| {
+        let e = geosens::mesh::methods::finite_difference(&scene, step).unwrap();
+        let caveats = geosens::Estimator::caveats(&e);
+        let r = run(&e, &RunConfig::new(400_000, 7).unwrap()).unwrap();
+        (caveats, r.get(&Quantity::sensitivity("tx")).unwrap())
+    };
+    let (caveats, wide) = fd(1e-3);
+    eprintln!("step 1e-3: {wide:?} vs exact {exact}; {caveats:?}");
+    assert!(
+        caveats
+            .iter()
+            .any(|(q, why)| *q == Quantity::sensitivity("tx") && why.contains("sweeps")),
+        "{caveats:?}"
+    );
+    // The caveat is needed: the quotient is far off.
+    assert!(wide.z_score(exact) > 6.0, "{wide:?} vs {exact}");
+    let (caveats, narrow) = fd(2e-5);
+    eprintln!("step 2e-5: {narrow:?} vs exact {exact}; {caveats:?}");
+    assert!(caveats.is_empty(), "{caveats:?}");
+    assert!(narrow.z_score(exact) < 4.0, "{narrow:?} vs {exact}");
+    let shipped = Arc::new(
+        geosens::mesh::file::load(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/mesh/occluder.toml"
+        )))
+        .unwrap(),
+    );
+    let caveats = geosens::Estimator::caveats(
+        &geosens::mesh::methods::finite_difference(&shipped, 1e-3).unwrap(),
+    );
+    assert!(caveats.is_empty(), "{caveats:?}");
+}

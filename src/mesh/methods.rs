@@ -257,6 +257,7 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
         if let Some(c) = passes_sensor(scene, j, h)
             .or_else(|| turns_face(scene, j, h, &plus, &minus))
             .or_else(|| outruns_lamp(scene, j, h))
+            .or_else(|| super::fd_view::view_crossing(scene, j, h, &plus, &minus))
         {
             caveats.push((p.name.clone(), c));
         }

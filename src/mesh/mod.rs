@@ -21,6 +21,7 @@ pub mod camera;
 pub mod cases;
 pub mod edges;
 pub mod exact;
+mod fd_view;
 #[cfg(feature = "figures")]
 pub mod figures;
 pub mod file;
