@@ -110,13 +110,7 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>, f64, [f64; 5])> {
     for (name, cx, cy, angle) in [("square", 0.3, 0.1, 0.0), ("rotated", -0.2, 0.25, 0.4)] {
         let mut o = OccluderScene::shipped(cx, cy);
         o.occ_angle = angle;
-        let occ = Shape {
-            name: "occ".into(),
-            vertices: o.occluder().to_vec(),
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-            surface: Surface::Absorber,
-            medium: None,
-        };
+        let occ = o.occluder_shape();
         out.push((
             name,
             build(occ, o.motions()),

@@ -172,13 +172,7 @@ fn occluders_match_the_closed_forms() {
     for (cx, cy, angle) in [(0.3, 0.1, 0.0), (-0.2, 0.25, 0.4)] {
         let mut o = OccluderScene::shipped(cx, cy);
         o.occ_angle = angle;
-        let shape = Shape {
-            name: "occ".into(),
-            vertices: o.occluder().to_vec(),
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-            surface: Surface::Absorber,
-            medium: None,
-        };
+        let shape = o.occluder_shape();
         cases.push((
             shape,
             o.motions(),
@@ -238,13 +232,7 @@ fn floor_radiance_and_sensor_gradient_match_the_closed_forms() {
     use std::f64::consts::PI;
     let o = OccluderScene::shipped(0.3, 0.1);
     let names = ["tx", "ty", "tz", "rot", "scale"];
-    let occ = Shape {
-        name: "occ".into(),
-        vertices: o.occluder().to_vec(),
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        surface: Surface::Absorber,
-        medium: None,
-    };
+    let occ = o.occluder_shape();
     let parameters: Vec<Parameter> = names
         .iter()
         .zip(o.motions())
@@ -597,13 +585,7 @@ fn a_moving_lamp_and_scaled_scenes_match_the_closed_forms() {
             vertices: sh.vertices.iter().map(|v| *v * k).collect(),
             ..sh
         };
-        let occ = Shape {
-            name: "occ".into(),
-            vertices: o.occluder().to_vec(),
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-            surface: Surface::Absorber,
-            medium: None,
-        };
+        let occ = o.occluder_shape();
         let motions = o.motions().map(|m| match m {
             Motion::Rotate { axis, pivot } => Motion::Rotate {
                 axis,
@@ -860,13 +842,7 @@ fn a_small_moving_mesh_keeps_its_error_bars_beside_a_large_one() {
     let names = ["tx", "ty", "tz", "rot", "scale"];
     let o = OccluderScene::shipped(0.3, 0.1);
     let (e, s) = (o.irradiance().unwrap(), o.sensitivities().unwrap());
-    let occ = Shape {
-        name: "occ".into(),
-        vertices: o.occluder().to_vec(),
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        surface: Surface::Absorber,
-        medium: None,
-    };
+    let occ = o.occluder_shape();
     let (v, t) = geosens::mesh::cases::icosphere(3);
     let ball = Shape {
         name: "ball".into(),
@@ -1582,13 +1558,7 @@ fn a_step_across_a_shadow_edge_reaching_the_lamps_is_a_caveat_for_finite_differe
     // Left shadow edge at 2 (cx − 0.25) = −0.4999; the others far inside
     // or outside the lamp.
     let o = OccluderScene::shipped(0.00005, 0.05);
-    let occ = Shape {
-        name: "occ".into(),
-        vertices: o.occluder().to_vec(),
-        triangles: vec![[0, 1, 2], [0, 2, 3]],
-        surface: Surface::Absorber,
-        medium: None,
-    };
+    let occ = o.occluder_shape();
     let exact = o.sensitivities().unwrap()[0];
     let scene = Arc::new(
         Scene::new(

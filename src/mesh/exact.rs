@@ -608,6 +608,17 @@ impl OccluderScene {
         })
     }
 
+    /// The occluder as a black mesh named `occ` (two triangles).
+    pub fn occluder_shape(&self) -> super::scene::Shape {
+        super::scene::Shape {
+            name: "occ".into(),
+            vertices: self.occluder().to_vec(),
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            surface: crate::path::Surface::Absorber,
+            medium: None,
+        }
+    }
+
     /// The five motions of [`Self::sensitivities`], pivots at the occluder's
     /// centre.
     pub fn motions(&self) -> [Motion; 5] {
