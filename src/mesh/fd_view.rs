@@ -1,18 +1,20 @@
 //! Whether the sensor's view changes within a central difference's step:
 //! the 3D twin of flatland's `view_change`. Seen from the sensor, the
-//! irradiance is a smooth function of a parameter while the outlines of
-//! the meshes keep their arrangement, and has a kink where a vertex of one
-//! outline crosses an edge of another (an occluder's shadow edge reaching
-//! the lamp's edge: the derivative drops to 0 there). A central difference
-//! whose step straddles such a crossing measures the quotient across the
-//! kink, not the derivative (a shadow edge 10⁻⁴ inside a lamp's edge, at
-//! the default step: −0.1477 ± 0.0069 against the exact −0.0206, marked
-//! reliable). So the two displaced scenes are compared: for every vertex
-//! of one mesh's outline seen within the arc of another mesh's outline
-//! edge, on which side of that edge's plane through the sensor it lies.
-//! Hidden crossings are counted too (a caveat where none was needed, not a
-//! wrong number). Book: chapter "Reliability", section "Finite differences
-//! across a change of visibility".
+//! irradiance is a smooth function of a parameter while the meshes'
+//! outlines keep their arrangement. A vertex of one outline crossing a
+//! generic edge of another leaves it differentiable, but an edge of one
+//! reaching the line of an edge of another (an occluder's shadow edge
+//! reaching the lamp's edge) is a kink: the derivative drops to 0 there. A
+//! central difference whose step straddles it measures the quotient across
+//! the kink, not the derivative (a shadow edge 10⁻⁴ inside a lamp's edge,
+//! at the default step: −0.1477 ± 0.0069 against the exact −0.0206, marked
+//! reliable). So the two displaced scenes are compared: an outline edge of
+//! the moved mesh and one of another opaque mesh, with overlapping arcs
+//! seen from the sensor, where both ends of one cross the other's plane
+//! through the sensor between the two scenes. Hidden edges count too (a
+//! caveat where none was needed, not a wrong number). Book: chapter
+//! "Reliability", section "Finite differences across a change of
+//! visibility".
 use super::scene::{Scene, Shape};
 use crate::path::Surface;
 use glam::DVec3;
@@ -55,29 +57,56 @@ fn within(a: DVec3, b: DVec3, v: DVec3) -> bool {
     a.cross(v).dot(n) > 0.0 && v.cross(b).dot(n) > 0.0
 }
 
+/// The outlines seen from the sensor of `scene`'s opaque meshes, by mesh
+/// (empty for a transparent one): [`view_crossing`]'s other meshes, found
+/// once for every parameter.
+pub fn outlines(scene: &Scene) -> Vec<Vec<[u32; 2]>> {
+    let x = scene.sensor().point();
+    scene
+        .shapes()
+        .iter()
+        .map(|s| {
+            if s.surface == Surface::Transparent {
+                Vec::new()
+            } else {
+                outline(s, x)
+            }
+        })
+        .collect()
+}
+
+/// `±1` (or 0) as `v` lies on either side of the plane through the sensor
+/// and the directions `a`, `b`.
+#[inline]
+fn side(a: DVec3, b: DVec3, v: DVec3) -> f64 {
+    a.cross(b).dot(v).signum()
+}
+
 /// Why the central difference along parameter `j` of `scene` (half step
-/// `h`, displaced scenes `plus` and `minus`) may straddle a kink: a vertex
-/// of the moved mesh's outline crosses the plane of another opaque mesh's
-/// outline edge within that edge's arc, or the reverse, between the two
-/// displaced scenes, as seen from the sensor.
+/// `h`, displaced scenes `plus` and `minus`; `outlines` the nominal
+/// scene's, from [`outlines`]) may straddle a kink: an outline edge of the
+/// moved mesh sweeps across the line of an outline edge of another opaque
+/// mesh, or the reverse, between the two displaced scenes, as seen from
+/// the sensor, their arcs overlapping.
 pub fn view_crossing(
     scene: &Scene,
     j: usize,
     h: f64,
     plus: &Scene,
     minus: &Scene,
+    outlines: &[Vec<[u32; 2]>],
 ) -> Option<String> {
     let k = scene.parameter_shape(j) as usize;
     let x = scene.sensor().point();
-    let moved = |s: &Scene| s.shapes()[k].clone();
-    let (mp, mm) = (moved(plus), moved(minus));
-    let (own_p, own_m) = (outline(&mp, x), outline(&mm, x));
-    let others: Vec<(&Shape, Vec<[u32; 2]>)> = scene
+    let (mp, mm) = (&plus.shapes()[k], &minus.shapes()[k]);
+    let (own_p, own_m) = (outline(mp, x), outline(mm, x));
+    let others: Vec<(&Shape, &[[u32; 2]])> = scene
         .shapes()
         .iter()
+        .zip(outlines)
         .enumerate()
-        .filter(|&(i, s)| i != k && s.surface != Surface::Transparent)
-        .map(|(_, s)| (s, outline(s, x)))
+        .filter(|&(i, (_, o))| i != k && !o.is_empty())
+        .map(|(_, (s, o))| (s, o.as_slice()))
         .collect();
     let other_edges: usize = others.iter().map(|o| o.1.len()).sum();
     let pairs = own_p.len() * 2 * other_edges * 3;
@@ -93,15 +122,14 @@ pub fn view_crossing(
         )
     };
     for (s, edges) in &others {
-        for e in edges {
+        for e in *edges {
             let (c, d) = ends(s, e);
             for f in &own_p {
-                let ((ap, bp), (am, bm)) = (ends(&mp, f), ends(&mm, f));
+                let ((ap, bp), (am, bm)) = (ends(mp, f), ends(mm, f));
                 // The moved edge's ends both cross the other's plane, or
                 // the other's ends both cross the moved edge's plane
                 // (a rotation about the sensor's line), within overlapping
                 // arcs.
-                let side = |a: DVec3, b: DVec3, v: DVec3| a.cross(b).dot(v).signum();
                 let swept = (side(c, d, ap) != side(c, d, am) && side(c, d, bp) != side(c, d, bm))
                     || (side(ap, bp, c) != side(am, bm, c) && side(ap, bp, d) != side(am, bm, d));
                 let overlap = |a: DVec3, b: DVec3| {

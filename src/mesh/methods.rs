@@ -239,6 +239,7 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
     let step = crate::error::check("h", step, step > 0.0, "a finite number > 0")?;
     let mut caveats = Vec::new();
     let mut pairs = Vec::new();
+    let outlines = super::fd_view::outlines(scene);
     for (j, p) in scene.parameters().iter().enumerate() {
         let (h, note) = match p.motion {
             Motion::TranslateX | Motion::TranslateY | Motion::TranslateZ => (
@@ -257,7 +258,7 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
         if let Some(c) = passes_sensor(scene, j, h)
             .or_else(|| turns_face(scene, j, h, &plus, &minus))
             .or_else(|| outruns_lamp(scene, j, h))
-            .or_else(|| super::fd_view::view_crossing(scene, j, h, &plus, &minus))
+            .or_else(|| super::fd_view::view_crossing(scene, j, h, &plus, &minus, &outlines))
         {
             caveats.push((p.name.clone(), c));
         }

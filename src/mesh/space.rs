@@ -471,10 +471,13 @@ impl Geometry for Space {
     fn cast(&self, x: DVec3, w: DVec3, skip: Prim) -> Option<Hit> {
         // A medium's boundary only touched at an edge or a vertex is passed
         // (`touch`), a few times at most.
-        let (mut from, mut skip, mut before) = (x, skip, 0.0);
-        for _ in 0..MAX_TOUCHES {
+        let (mut from, mut skip, mut before, mut touches) = (x, skip, 0.0, 0);
+        loop {
             let (t, prim) = self.caster.closest_hit(from, w, f64::INFINITY, skip)?;
-            if self.surface(prim) != Surface::Transparent || !self.touches_only(from, w, prim, t) {
+            if touches == MAX_TOUCHES
+                || self.surface(prim) != Surface::Transparent
+                || !self.touches_only(from, w, prim, t)
+            {
                 return Some(Hit {
                     t: before + t,
                     prim,
@@ -483,13 +486,8 @@ impl Geometry for Space {
             before += t;
             from += w * t;
             skip = prim;
+            touches += 1;
         }
-        self.caster
-            .closest_hit(from, w, f64::INFINITY, skip)
-            .map(|(t, prim)| Hit {
-                t: before + t,
-                prim,
-            })
     }
     #[inline]
     fn visible(&self, x: DVec3, y: DVec3, skip: Prim) -> bool {

@@ -23,10 +23,10 @@ impl Scene {
     /// dir`; a medium's corner the ray only touches is passed.
     #[inline]
     pub fn cast(&self, origin: DVec2, dir: DVec2, skip: u32) -> Option<Hit> {
-        let (mut from, mut skip, mut before) = (origin, skip, 0.0);
-        for _ in 0..MAX_TOUCHES {
+        let (mut from, mut skip, mut before, mut touches) = (origin, skip, 0.0, 0);
+        loop {
             let h = self.caster.closest_hit(from, dir, f64::INFINITY, skip)?;
-            if !self.touches_only(from, dir, h) {
+            if touches == MAX_TOUCHES || !self.touches_only(from, dir, h) {
                 return Some(Hit {
                     t: before + h.t,
                     ..h
@@ -35,13 +35,8 @@ impl Scene {
             before += h.t;
             from += dir * h.t;
             skip = h.segment;
+            touches += 1;
         }
-        self.caster
-            .closest_hit(from, dir, f64::INFINITY, skip)
-            .map(|h| Hit {
-                t: before + h.t,
-                ..h
-            })
     }
 
     /// Whether the ray from `x` along `dir` meets a medium's boundary at
