@@ -134,6 +134,9 @@ impl Geometry for Triangles {
     fn coefficients(&self, _m: MediumId) -> Option<(f64, f64)> {
         None
     }
+    fn medium_chord(&self, _m: MediumId) -> f64 {
+        f64::INFINITY
+    }
     fn crossed(&self, m: MediumId, _k: u32) -> MediumId {
         m
     }

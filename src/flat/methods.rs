@@ -15,11 +15,14 @@ use super::scene::Scene;
 use super::space::Plane;
 use crate::error::{Error, check};
 use crate::estimator::{Estimator, Quantity};
-use crate::fd::{CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement};
+use crate::fd::{
+    CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement, thin_medium_caveat,
+};
 use crate::method::Problem;
 use crate::path::deform::Slots;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::intensity::IntensityEstimator;
+use crate::path::thin_media::chord_bound;
 use std::sync::Arc;
 
 /// The methods: every [`Method`] runs on a flatland scene
@@ -218,7 +221,7 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
                     .map_err(|e| invalid_displacement("scene", &p.name, delta, &note, e))
             };
             let (plus, minus) = (displaced(h)?, displaced(-h)?);
-            let caveat = view_change(scene, j, h, &plus, &minus);
+            let caveat = view_change(scene, j, h, &plus, &minus).or_else(|| thin_medium(scene, j));
             Ok((
                 Pair {
                     parameter: p.name.clone(),
@@ -318,4 +321,20 @@ fn sensor_view(scene: &Scene) -> Vec<u32> {
 /// 0 (the field is pinned to the frame at the horizons).
 pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
     super::boundaries::sensor_warp(plane, phi)
+}
+
+/// The thin-medium caveat of finite differences along parameter `j`
+/// ([`thin_medium_caveat`]): the media of its shape and of the shape it
+/// lies in.
+fn thin_medium(scene: &Scene, j: usize) -> Option<String> {
+    let k = scene.parameter_shape(j);
+    let media = [Some(k), scene.parent_medium(k)]
+        .into_iter()
+        .flatten()
+        .filter_map(|k| {
+            let s = &scene.shapes()[k as usize];
+            let m = s.medium.as_ref()?;
+            Some((s.name.as_str(), m.ks, chord_bound(&s.vertices)))
+        });
+    thin_medium_caveat(media)
 }

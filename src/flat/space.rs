@@ -8,6 +8,7 @@ use super::geometry::{NO_SEGMENT, cross};
 use super::lobe::FlatLobe;
 use super::scene::{Phase, Scene, Sensor as FlatSensor};
 use crate::path::deform::SlotSet;
+use crate::path::thin_media::chord_bound;
 use crate::path::{Geometry, Hit, MediumId, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec2;
@@ -37,6 +38,8 @@ pub struct Plane {
     pub(super) shape_corners: Vec<(u32, u32)>,
     /// Per shape, the parameters that move it.
     pub(super) shape_params: Vec<SlotSet>,
+    /// Per shape, a bound on its chords ([`chord_bound`]).
+    chords: Vec<f64>,
     /// The shapes some parameter moves whose corners weigh (> 0).
     pub(super) weighed_shapes: Vec<u32>,
     /// Every parameter's slot, and for that view the parameters with a
@@ -162,7 +165,13 @@ impl Plane {
                     && shape_cdf[end as usize - 1] > 0.0
             })
             .collect();
+        let chords = scene
+            .shapes()
+            .iter()
+            .map(|s| chord_bound(&s.vertices))
+            .collect();
         Plane {
+            chords,
             scene,
             corner_segments,
             moving_corners,
@@ -371,6 +380,10 @@ impl Geometry for Plane {
     #[inline]
     fn coefficients(&self, m: MediumId) -> Option<(f64, f64)> {
         self.scene.medium(m).map(|m| (m.ks, m.ke))
+    }
+    #[inline]
+    fn medium_chord(&self, m: MediumId) -> f64 {
+        m.map_or(f64::INFINITY, |k| self.chords[k as usize])
     }
     #[inline]
     fn crossed(&self, m: MediumId, k: u32) -> MediumId {

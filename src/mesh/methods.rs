@@ -19,11 +19,14 @@ use super::scene::{Motion, Scene};
 use super::space::Space;
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
-use crate::fd::{CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement};
+use crate::fd::{
+    CentralDifference, DEFAULT_STEP, Pair, check_step, invalid_displacement, thin_medium_caveat,
+};
 use crate::method::{Method, Problem};
 use crate::path::deform::Slots;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::intensity::IntensityEstimator;
+use crate::path::thin_media::chord_bound;
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
 
@@ -259,6 +262,7 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
             .or_else(|| turns_face(scene, j, h, &plus, &minus))
             .or_else(|| outruns_lamp(scene, j, h))
             .or_else(|| super::fd_view::view_crossing(scene, j, h, &plus, &minus, &outlines))
+            .or_else(|| thin_medium(scene, j))
         {
             caveats.push((p.name.clone(), c));
         }
@@ -552,4 +556,20 @@ pub fn point_triangle_distance(p: glam::DVec3, t: &[glam::DVec3; 3]) -> f64 {
             (p - (a + d * s)).length()
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// The thin-medium caveat of finite differences along parameter `j`
+/// ([`thin_medium_caveat`]): the media of its shape and of the shape it
+/// lies in.
+fn thin_medium(scene: &Scene, j: usize) -> Option<String> {
+    let k = scene.parameter_shape(j);
+    let media = [Some(k), scene.parent_medium(k)]
+        .into_iter()
+        .flatten()
+        .filter_map(|k| {
+            let s = &scene.shapes()[k as usize];
+            let m = s.medium.as_ref()?;
+            Some((s.name.as_str(), m.ks, chord_bound(&s.vertices)))
+        });
+    thin_medium_caveat(media)
 }

@@ -13,6 +13,7 @@ use super::scene::{Scene, Sensor as SceneSensor};
 use super::sensor_view::SensorView;
 use super::warp::{MAX_FIELDS, PoleRule};
 use crate::path::deform::SlotSet;
+use crate::path::thin_media::chord_bound;
 use crate::path::{Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec3;
@@ -77,6 +78,8 @@ pub struct Space {
     pub(super) sensor_shape_lamps: Vec<OnceLock<([f64; LAMP_EDGES], f64)>>,
     /// Per mesh, the parameters that move it.
     pub(super) shape_params: Vec<SlotSet>,
+    /// Per mesh, a bound on its chords ([`chord_bound`]).
+    chords: Vec<f64>,
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
     pub(super) pole_rules: Vec<PoleRule>,
@@ -216,6 +219,11 @@ impl Space {
             shape_params[scene.parameter_shape(j) as usize].insert(j);
         }
         Space {
+            chords: scene
+                .shapes()
+                .iter()
+                .map(|s| chord_bound(&s.vertices))
+                .collect(),
             caster: TriangleBvh::new(tris.clone()),
             opaque: TriangleBvh::new(opaque_tris),
             opaque_index,
@@ -528,6 +536,10 @@ impl Geometry for Space {
     #[inline]
     fn coefficients(&self, m: MediumId) -> Option<(f64, f64)> {
         self.scene.medium(m).map(|m| (m.ks, m.ke))
+    }
+    #[inline]
+    fn medium_chord(&self, m: MediumId) -> f64 {
+        m.map_or(f64::INFINITY, |k| self.chords[k as usize])
     }
     #[inline]
     fn crossed(&self, m: MediumId, k: u32) -> MediumId {

@@ -28,6 +28,7 @@ pub mod estimator;
 pub mod expectation;
 pub mod intensity;
 pub mod rendering;
+pub mod thin_media;
 pub mod transport;
 pub mod walk;
 
@@ -291,6 +292,12 @@ pub trait Geometry: Sync {
     }
     /// `(κs, κe)` of a medium.
     fn coefficients(&self, m: MediumId) -> Option<(f64, f64)>;
+    /// An upper bound on the length of a straight path inside medium `m`
+    /// ([`thin_media::chord_bound`] of its boundary's vertices): in an
+    /// optically thin medium the walk draws collisions as if it were
+    /// [`thin_media::THIN_DEPTH`] thick over this length
+    /// ([`thin_media::collision_rate`]).
+    fn medium_chord(&self, m: MediumId) -> f64;
     /// The medium entered or left when a ray in `m` crosses the transparent
     /// boundary of shape `k`.
     fn crossed(&self, m: MediumId, k: u32) -> MediumId;

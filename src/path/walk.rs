@@ -1,11 +1,13 @@
 //! The one event loop: backward path tracing with free paths
-//! `ξ ~ κs e^{−κs ξ}` in homogeneous media (absorption carried as the
-//! weight `e^{−κa ξ}`), surface events, next-event estimation with multiple
+//! `ξ ~ μ e^{−μ ξ}` in homogeneous media (`μ = κs`, raised in optically thin
+//! media so that their rare collisions are drawn; the rest of the
+//! extinction carried as the weight `(κs/μ) e^{−(κe−μ) ξ}`), surface events, next-event estimation with multiple
 //! importance sampling (power heuristic) at every scattering vertex, and
 //! Russian roulette on the throughput. The intensity estimator is this loop
 //! with the unit hooks `()`; each derivative method observes its events
 //! through [`Hooks`] and adds its own terms. Book: chapter "Flatland",
 //! sections "Backward path tracing" and "Next-event estimation".
+use super::thin_media::collision_rate;
 use super::{Geometry, Hit, Lobe, MediumId, NO_PRIM, Prim, Surface, Vector, mis};
 use crate::rng::{PathRng, free_path};
 use rand::RngExt;
@@ -321,9 +323,16 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                 let leg = Leg { x, w, medium, beta };
                 hooks.free_path_domain(g, rng, &leg, t_b);
             }
-            let xi = free_path(ks, rng);
+            // A path escaping a medium (rounding) keeps the plain rate: its
+            // pass weight would have no bound.
+            let mu = if hit.is_some() {
+                collision_rate(ks, g.medium_chord(medium))
+            } else {
+                ks
+            };
+            let xi = free_path(mu, rng);
             if xi < t_b {
-                beta *= (-(ke - ks) * xi).exp();
+                beta *= ks / mu * (-(ke - mu) * xi).exp();
                 hooks.collision(w, xi, t_b, ke);
                 x = x + w * xi;
                 hooks.visit(x);
@@ -350,7 +359,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                 }
                 continue;
             }
-            beta *= (-(ke - ks) * t_b).exp();
+            beta *= (-(ke - mu) * t_b).exp();
             hooks.pass(ke);
         }
         let Some(h) = hit else {
