@@ -71,7 +71,7 @@ pub fn invalid_displacement(
 /// varies at that rate with the boundary and a pair that collides on one
 /// side and passes on the other jumps by `O(1)`: `O(h)` of the pairs carry
 /// a share `O(1/h)` each, a tail that a run sees only in part (a thin fog's
-/// rotation read −6.4·10⁻⁴ ± 1·10⁻⁵ against 1.7·10⁻⁸). The other methods
+/// rotation read −2.5·10⁻⁴ ± 4·10⁻⁶ against 1.7·10⁻⁸). The other methods
 /// have no such jumps.
 pub fn thin_medium_caveat<'a>(
     media: impl IntoIterator<Item = (&'a str, f64, f64)>,

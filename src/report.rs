@@ -131,6 +131,15 @@ impl MeanErr {
     }
 }
 
+/// A table's `reliable` column: `caveat` where the estimator gave one.
+fn reliable_text(e: &Estimate, caveat: Option<&String>) -> &'static str {
+    match (e.is_reliable(), caveat) {
+        (true, None) => "yes",
+        (_, Some(_)) => "caveat",
+        (false, None) => "no",
+    }
+}
+
 /// The caveat on quantity `q` among `caveats`, if any.
 pub fn caveat_of<'a>(caveats: &'a [(Quantity, String)], q: &Quantity) -> Option<&'a String> {
     caveats.iter().find(|(k, _)| k == q).map(|(_, why)| why)
@@ -337,7 +346,8 @@ impl Report {
                 dash(mc, || e.nonzero.to_string()),
                 dash(mc, || format!("{:.1e}", e.vov)),
                 dash(mc, || format!("{:.1e}", e.max_share)),
-                dash(mc, || yes_no(e.is_reliable()).to_owned()),
+                dash(mc, || reliable_text(e, caveat_of(&self.caveats, q))
+                    .to_owned()),
                 dash(mc, || format!("{ex:.6e}")),
                 dash(mc, || z_text(e, ex)),
             );
@@ -370,11 +380,7 @@ impl Report {
                 e.nonzero,
                 e.vov,
                 e.max_share,
-                match (e.is_reliable(), caveat) {
-                    (true, None) => "yes",
-                    (_, Some(_)) => "caveat",
-                    (false, None) => "no",
-                }
+                reliable_text(e, caveat)
             );
         }
         t

@@ -16,11 +16,11 @@ use super::Vector;
 /// carry (a scattering point moving with the medium) are missing while the
 /// error bar, blind to what was never drawn, stays small. Drawn at the rate
 /// `μ = max(κs, THIN_DEPTH/ℓ)`, a path crossing the medium collides with
-/// probability up to `1 − e^{−THIN_DEPTH}` ≈ 22 %, whatever `κs`; the weights
+/// probability up to `1 − e^{−THIN_DEPTH}` ≈ 9.5 %, whatever `κs`; the weights
 /// `(κs/μ) e^{−(κe−μ) ξ}` (collision) and `e^{−(κe−μ) t_b}` (pass) keep every
 /// estimate unbiased, and the pass weight stays below `e^{THIN_DEPTH}`.
 /// Media with `κs ℓ ≥ THIN_DEPTH` are drawn as before, bit for bit.
-pub const THIN_DEPTH: f64 = 0.25;
+pub const THIN_DEPTH: f64 = 0.1;
 
 /// The rate `μ` of the free paths drawn in a medium of scattering
 /// coefficient `ks` whose straight paths are at most `chord` long

@@ -104,7 +104,7 @@ impl Estimator for ExpectationEstimator {
             weights.fill(0.0);
             return;
         };
-        let w = score(rod, exit.side, exit.length);
+        let w = score(rod, exit.side, exit.length) * exit.bias;
         weights[0] = w;
         weights[1] = w * (v.divergence - rod.ke * v.length);
     }

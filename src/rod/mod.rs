@@ -242,6 +242,8 @@ fn check_collisions(rod: &Rod) -> Result<(), Error> {
 /// `probe`, then `[I(π̃ + h) − I(π̃ − h)]/2h` with `h = step × π̃`; errors if
 /// the probe is at the moving end (`x = π̃`) or a displaced rod is invalid
 /// (the probe beyond the shortened rod's end, the lengthened rod too thick).
+/// An optically thin rod's difference carries a caveat
+/// ([`thin_medium_caveat`](crate::fd::thin_medium_caveat)).
 pub fn finite_difference(rod: Rod, probe: Probe, step: f64) -> Result<CentralDifference, Error> {
     if probe.x >= rod.length {
         return Err(Error::Scene(format!(
@@ -267,7 +269,14 @@ pub fn finite_difference(rod: Rod, probe: Probe, step: f64) -> Result<CentralDif
         minus: displaced(-h)?,
         half_step: h,
     };
-    CentralDifference::new(Some(Method::Intensity.estimator((rod, probe))?), vec![pair])
+    let fd = CentralDifference::new(Some(Method::Intensity.estimator((rod, probe))?), vec![pair])?;
+    // A thin rod's collisions are drawn at a raised rate: its pairs jump.
+    Ok(
+        match crate::fd::thin_medium_caveat([("rod", rod.ks, rod.length)]) {
+            Some(why) => fd.with_caveat(PARAMETER, why),
+            None => fd,
+        },
+    )
 }
 
 /// The name of the rod's shape parameter in estimator outputs.

@@ -42,7 +42,7 @@ impl Estimator for RenderingEstimator {
         };
         match exit.side {
             Side::Start => {
-                weights[0] = score(rod, Side::Start, exit.length);
+                weights[0] = score(rod, Side::Start, exit.length) * exit.bias;
                 weights[1] = 0.0;
             }
             Side::End => {
@@ -52,7 +52,9 @@ impl Estimator for RenderingEstimator {
                 weights[1] = if rod.ks > 0.0 {
                     match walk(rod, rod.length, Direction::Left, rng, &mut ()) {
                         Some(nested) => {
-                            0.5 * rod.ks * score(rod, nested.side, exit.length + nested.length)
+                            0.5 * rod.ks
+                                * score(rod, nested.side, exit.length + nested.length)
+                                * (exit.bias * nested.bias)
                         }
                         None => 0.0,
                     }

@@ -84,7 +84,7 @@ pub fn solve<const N: usize>(
         // Nothing to attenuate: skip the exponential (a · ±0 = ±0 anyway).
         return s;
     }
-    let a = attenuation(rod, exit.length);
+    let a = attenuation(rod, exit.length) * exit.bias;
     s.map(|v| a * v)
 }
 // ANCHOR_END: solve

@@ -4,6 +4,14 @@
 //! distance `d̂` (Eq. 27). Absorption is not sampled: it is the weight
 //! `e^{−κa L}` of the total length `L`.
 //!
+//! In an optically thin rod (`κs π̃ <` [`THIN_DEPTH`](crate::path::thin_media::THIN_DEPTH)) a run would draw
+//! almost no collision, and what only collisions carry (the light scattered
+//! back toward the probe) would be missing behind a zero error bar: the free
+//! paths are then drawn at the raised rate `μ = THIN_DEPTH/π̃` of
+//! [`collision_rate`], and [`Exit::bias`] carries the ratio of the two
+//! densities, `(κs/μ)^n e^{(μ−κs)L}` for `n` collisions, into every weight.
+//! The paper's rods (`κs π̃` = 0.14 and 4.2) are drawn at `κs`, bit for bit.
+//!
 //! Since absorption never ends a path, a path deep in a thick absorbing rod
 //! would scatter ~`(κs π̃)²/4` times before it escaped (millions of times,
 //! 22 ms per path, at `κs π̃ = 5000`) while its weight is long 0:
@@ -27,6 +35,7 @@
 //! unit observer `()` compiles away. Book: chapter "Backward path tracing of
 //! the intensity".
 use super::{Direction, Rod, Side};
+use crate::path::thin_media::collision_rate;
 use crate::rng::PathRng;
 use rand::Rng;
 
@@ -37,6 +46,10 @@ pub struct Exit {
     pub side: Side,
     /// Total path length `L = Σ ξ_k + d̂_J`.
     pub length: f64,
+    /// The plain walk's density over this one's (free paths drawn at `μ`
+    /// rather than `κs`): `(κs/μ)^n e^{(μ−κs)L}`, exactly 1 where `μ = κs`.
+    /// Every weight of the path carries it.
+    pub bias: f64,
 }
 
 /// Absorption depth `κa L` from which the weight `e^{−κa L}` is exactly 0 in
@@ -86,17 +99,27 @@ pub fn walk<E: Events>(
     let mut length = 0.0;
     // The length at which e^{−κa L} is 0: ∞ without absorption.
     let absorbed = ABSORBED / rod.ka();
+    let mu = collision_rate(rod.ks, rod.length);
+    let mut collisions = 0.0;
     let exit = loop {
         let d = rod.distance_to_boundary(x, dir);
-        let xi = free_path(rod.ks, &mut local);
+        let xi = free_path(mu, &mut local);
         if xi >= d {
             events.escape(dir, d);
+            let length = length + d;
+            let bias = if mu > rod.ks {
+                (collisions * (rod.ks / mu).ln() + (mu - rod.ks) * length).exp()
+            } else {
+                1.0
+            };
             break Some(Exit {
                 side: dir.end(),
-                length: length + d,
+                length,
+                bias,
             });
         }
         events.collision(dir, xi, d);
+        collisions += 1.0;
         length += xi;
         if length >= absorbed {
             break None;
@@ -114,7 +137,8 @@ pub fn walk<E: Events>(
 /// an absorbed path.
 #[inline]
 pub fn intensity_weight(rod: &Rod, x: f64, dir: Direction, rng: &mut PathRng) -> f64 {
-    walk(rod, x, dir, rng, &mut ()).map_or(0.0, |exit| score(rod, exit.side, exit.length))
+    walk(rod, x, dir, rng, &mut ())
+        .map_or(0.0, |exit| score(rod, exit.side, exit.length) * exit.bias)
 }
 
 /// The incoming intensity at `side` attenuated over `length`: `Î e^{−κa L}`,
