@@ -645,3 +645,33 @@ fn a_thin_rod_against_bellman_wing() {
     }
     assert!(reliable > 100, "{reliable} reliable estimates");
 }
+
+/// Finite differences along a parameter whose shape lies in a thin medium
+/// (an occluder, a reflector and a lamp submerged in thin fog) carry the
+/// thin-medium caveat, and in the same fog at its shipped thickness none.
+#[test]
+fn finite_differences_inside_a_thin_medium_carry_a_caveat() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/submerged.toml"
+    ))
+    .unwrap();
+    let thin = text.replace("ks = 1.0, ke = 1.3", "ks = 1e-5, ke = 1.3e-5");
+    assert_ne!(thin, text);
+    for (text, thin) in [(thin, true), (text, false)] {
+        let scene = Arc::new(geosens::flat::file::from_toml(&text).unwrap());
+        let caveats = Method::Fd.estimator(scene.clone()).unwrap().caveats();
+        for p in scene.parameters() {
+            let why = caveats
+                .iter()
+                .find(|(q, _)| *q == Quantity::sensitivity(&p.name))
+                .map(|(_, why)| why.as_str());
+            assert_eq!(
+                why.is_some_and(|w| w.contains("optically thin medium")),
+                thin,
+                "{}: {why:?}",
+                p.name
+            );
+        }
+    }
+}

@@ -255,7 +255,7 @@ pub struct Scene {
     /// Vertices of opaque shapes with their shape: where the integrand over
     /// directions seen from a point can jump.
     corners: Vec<(DVec2, u32)>,
-    /// For each shape, the medium shape around it (media only).
+    /// For each shape, the medium shape around it.
     parent: Vec<Option<u32>>,
     sensor_medium: Option<u32>,
     size: f64,
@@ -434,7 +434,8 @@ impl Scene {
     pub fn corners(&self) -> &[(DVec2, u32)] {
         &self.corners
     }
-    /// The medium shape enclosing shape `k` (for media).
+    /// The medium shape enclosing shape `k` (tested at its first vertex:
+    /// shapes do not cross).
     #[inline]
     pub fn parent_medium(&self, k: u32) -> Option<u32> {
         self.parent[k as usize]

@@ -524,8 +524,8 @@ fn check_optical_thickness(shapes: &[Shape], size: f64) -> Result<(), Error> {
 /// Most scattering events a path is expected to need in one medium.
 pub const MAX_SCATTERING_EVENTS: f64 = 1e5;
 
-/// The medium shape around each medium shape, and the one around the
-/// sensor at `p`.
+/// The medium shape around each shape (tested at its first vertex: shapes
+/// do not cross), and the one around the sensor at `p`.
 fn nest_media(shapes: &[Shape], p: DVec2) -> (Vec<Option<u32>>, Option<u32>) {
     // The medium around a point: the smallest medium polygon holding it
     // (shapes do not cross, so media nest).
@@ -550,7 +550,7 @@ fn nest_media(shapes: &[Shape], p: DVec2) -> (Vec<Option<u32>>, Option<u32>) {
     let parent = shapes
         .iter()
         .enumerate()
-        .map(|(k, s)| s.medium.and_then(|_| medium_at(s.vertices[0], Some(k))))
+        .map(|(k, s)| medium_at(s.vertices[0], Some(k)))
         .collect();
     (parent, medium_at(p, None))
 }
