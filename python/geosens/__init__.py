@@ -27,6 +27,7 @@ paths are sampled, so other Python threads run meanwhile.
 from __future__ import annotations
 
 import json
+import operator
 import os
 import warnings
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
@@ -49,17 +50,23 @@ StateLike = Union[Dict[str, Any], str, "os.PathLike[str]"]
 
 
 def _uint(name: str, value: Any) -> int:
-    """``value`` if it is an integer from 0 to 2⁶⁴ − 1, else ValueError
-    (Rust takes u64; past it, pyo3 raised an OverflowError naming nothing)."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, int)
-        or not 0 <= value < 2**64
-    ):
-        raise ValueError(
-            f"invalid value {value!r} for {name}: expected an integer from 0 to 2^64 - 1"
-        )
-    return value
+    """``value`` as an ``int`` if it is an integer from 0 to 2⁶⁴ − 1, else
+    ValueError. An integer is anything with ``__index__`` (numpy's
+    ``np.int64``, what a sweep over ``np.arange`` or ``np.logspace(...)
+    .astype(int)`` hands over), but not a bool: ``paths=True`` is a mistake.
+    Rust takes u64; past it, pyo3 raised an OverflowError naming nothing."""
+    bad = ValueError(
+        f"invalid value {value!r} for {name}: expected an integer from 0 to 2^64 - 1"
+    )
+    if isinstance(value, (bool, np.bool_)):
+        raise bad
+    try:
+        n = operator.index(value)
+    except TypeError:
+        raise bad from None
+    if not 0 <= n < 2**64:
+        raise bad
+    return n
 
 
 def _real(name: str, value: Any) -> float:
@@ -161,6 +168,9 @@ def rod(
         paths: paths of the run (at least 2, checked for ``exact`` too).
         seed: seed of the random streams.
         threads: worker threads, 0 = all cores (results do not depend on it).
+            ``paths``, ``seed``, ``threads`` and ``shard``'s numbers take any
+            integer (numpy's too: anything with ``__index__``), not a bool
+            or a float.
         fd_step: half step of ``fd`` (relative to the length).
         shard: ``(i, n)``: run shard i of n and return its state.
 
