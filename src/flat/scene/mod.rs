@@ -283,6 +283,39 @@ fn config<T>(msg: String) -> Result<T, Error> {
     Err(Error::Scene(msg))
 }
 
+/// The axes of flatland's sensor gradient (transport's `∂I/∂x`, `∂I/∂y`).
+pub(crate) const GRADIENT_AXES: [&str; 2] = ["x", "y"];
+
+/// Rejects the name of parameter `j` if it is empty or if its output would
+/// be taken for another quantity's: a gradient axis of `axes` (its
+/// `∂I/∂x` row would stand beside the sensor gradient's, which transport
+/// prints under the same name) or `I` (a rendering's intensity image, keyed
+/// `I` beside the parameters' images in Python). Flatland's and 3D's
+/// validation both.
+pub(crate) fn check_parameter_name(
+    j: usize,
+    p: &str,
+    shape: &str,
+    axes: &[&str],
+) -> Result<(), Error> {
+    let clash = if p.is_empty() {
+        return config(format!("parameter {j} has an empty name"));
+    } else if axes.contains(&p) {
+        format!(
+            "an axis of the sensor gradient: its ∂I/∂{p} could not be told from the \
+             gradient's"
+        )
+    } else if p == "I" {
+        "the intensity: a rendering's images of the two would share the key \"I\"".to_owned()
+    } else {
+        return Ok(());
+    };
+    config(format!(
+        "parameter {p:?} has the name of {clash}; rename it (for example {:?})",
+        format!("{shape}_{p}")
+    ))
+}
+
 impl Scene {
     /// The same scene with parameter `j` changed by `delta` (its shape
     /// moved), validated again.

@@ -372,9 +372,7 @@ fn resolve_parameters(
     }
     let mut names = std::collections::HashSet::with_capacity(parameters.len());
     for (j, p) in parameters.iter().enumerate() {
-        if p.name.is_empty() {
-            return config(format!("parameter {j} has an empty name"));
-        }
+        super::check_parameter_name(j, &p.name, &p.shape, &super::GRADIENT_AXES)?;
         if !names.insert(p.name.as_str()) {
             return config(format!("two parameters are named {:?}", p.name));
         }

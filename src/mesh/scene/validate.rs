@@ -26,7 +26,7 @@ use super::{
     MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion, Parameter, Scene, Sensor, Shape, Surface,
 };
 use crate::error::{Error, Num};
-use crate::flat::scene::MAX_SCATTERING_EVENTS;
+use crate::flat::scene::{MAX_SCATTERING_EVENTS, check_parameter_name};
 use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 
@@ -411,9 +411,12 @@ fn resolve_parameters(
     let mut resolved = Vec::with_capacity(parameters.len());
     let mut names = HashSet::with_capacity(parameters.len());
     for (j, p) in parameters.iter().enumerate() {
-        if p.name.is_empty() {
-            return config(format!("parameter {j} has an empty name"));
-        }
+        check_parameter_name(
+            j,
+            &p.name,
+            &p.shape,
+            &crate::mesh::methods::AXES.map(|a| a.0),
+        )?;
         if !names.insert(p.name.as_str()) {
             return config(format!("two parameters are named {:?}", p.name));
         }
