@@ -5,8 +5,9 @@
 //! rules); the path tracer then never meets a degenerate configuration.
 //!
 //! This file holds the data types and the validated [`Scene`] with its
-//! accessors; `validate` builds a scene step by step and `repr` holds the
-//! file forms of the tagged enums.
+//! accessors; `validate` builds a scene step by step (with the checks in
+//! `shared`, which 3D's validation uses too) and `repr` holds the file
+//! forms of the tagged enums.
 use super::corners::CornerTree;
 use super::geometry::{NO_SEGMENT, RayCast, Segment, perp};
 use crate::error::Error;
@@ -14,14 +15,15 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 mod repr;
+mod shared;
 #[cfg(test)]
 mod tests;
 mod touch;
 mod validate;
 
-pub(crate) use validate::check_extent;
-pub(crate) use validate::check_pivot;
-pub use validate::{MAX_OFFSET, MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE};
+pub(crate) use shared::{GRADIENT_AXES, check_extent, check_parameter_name, check_pivot};
+pub use shared::{MAX_OFFSET, MAX_SIZE, MIN_SIZE};
+pub use validate::MAX_SCATTERING_EVENTS;
 
 /// Largest extinction coefficient times scene size accepted: beyond it a
 /// medium is opaque for every purpose and the weights underflow.
@@ -281,39 +283,6 @@ impl Clone for Scene {
 /// A scene error with message `msg`.
 fn config<T>(msg: String) -> Result<T, Error> {
     Err(Error::Scene(msg))
-}
-
-/// The axes of flatland's sensor gradient (transport's `∂I/∂x`, `∂I/∂y`).
-pub(crate) const GRADIENT_AXES: [&str; 2] = ["x", "y"];
-
-/// Rejects the name of parameter `j` if it is empty or if its output would
-/// be taken for another quantity's: a gradient axis of `axes` (its
-/// `∂I/∂x` row would stand beside the sensor gradient's, which transport
-/// prints under the same name) or `I` (a rendering's intensity image, keyed
-/// `I` beside the parameters' images in Python). Flatland's and 3D's
-/// validation both.
-pub(crate) fn check_parameter_name(
-    j: usize,
-    p: &str,
-    shape: &str,
-    axes: &[&str],
-) -> Result<(), Error> {
-    let clash = if p.is_empty() {
-        return config(format!("parameter {j} has an empty name"));
-    } else if axes.contains(&p) {
-        format!(
-            "an axis of the sensor gradient: its ∂I/∂{p} could not be told from the \
-             gradient's"
-        )
-    } else if p == "I" {
-        "the intensity: a rendering's images of the two would share the key \"I\"".to_owned()
-    } else {
-        return Ok(());
-    };
-    config(format!(
-        "parameter {p:?} has the name of {clash}; rename it (for example {:?})",
-        format!("{shape}_{p}")
-    ))
 }
 
 impl Scene {

@@ -5,8 +5,9 @@
 //! parameters, sensor, media), so a scene with several faults always reports
 //! the first of them.
 use super::{
-    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion,
-    Parameter, Phase, Scene, Sensor, Shape, Surface, config,
+    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, GRADIENT_AXES, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS,
+    Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface, check_extent,
+    check_parameter_name, check_pivot, config,
 };
 use crate::error::{Error, Num};
 use crate::flat::corners::CornerTree;
@@ -118,63 +119,6 @@ fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
         lo.abs().max(hi.abs()).max_element(),
     )
 }
-
-/// A scene's size (the largest extent of its vertices' bounding box) within
-/// [`MIN_SIZE`]..[`MAX_SIZE`], and `far`, its farthest coordinate from the
-/// origin, within [`MAX_OFFSET`] times it; returns the size. Flatland's
-/// and 3D's validation both.
-pub(crate) fn check_extent(size: f64, far: f64) -> Result<f64, Error> {
-    if !(MIN_SIZE..=MAX_SIZE).contains(&size) {
-        return config(format!(
-            "the scene's size (largest extent of its vertices' bounding box) is {size:e}: \
-             sizes from {MIN_SIZE:e} to {MAX_SIZE:e} are supported; rescale the scene \
-             (only κ × size and ratios of lengths matter)"
-        ));
-    }
-    if far > MAX_OFFSET * size {
-        return config(format!(
-            "the scene lies {far:e} from the origin, {:.1e} times its size {size:e}: \
-             at most {MAX_OFFSET:e} times is supported (farther, its coordinates keep \
-             too few digits of its geometry); move the scene nearer the origin",
-            far / size
-        ));
-    }
-    Ok(size)
-}
-
-/// Refuses a pivot farther than [`MAX_OFFSET`] sizes from the shape it
-/// turns or scales (`distance`, along the farthest axis: a length would
-/// overflow): the motion's velocities grow with that
-/// distance, and past it a rotation read 0 with no warning (pivot 10¹⁶⁰
-/// away) or its diagnostics NaN (10¹⁰⁰). Flatland's and 3D's validation
-/// both.
-pub(crate) fn check_pivot(name: &str, distance: f64, size: f64) -> Result<(), Error> {
-    if distance > MAX_OFFSET * size {
-        return config(format!(
-            "parameter {name:?}: its pivot lies {distance:e} from the shape it moves, {:.1e} \
-             times the scene's size {size:e}: at most {MAX_OFFSET:e} times is supported \
-             (such a rotation or scale is a translation of enormous speed)",
-            distance / size
-        ));
-    }
-    Ok(())
-}
-
-/// Smallest and largest scene size accepted: within them every squared
-/// length and cross product the tracer forms is a normal float, and so is
-/// the fourth power of a translation's weight (∝ 1/size) that the
-/// variance-of-the-variance diagnostic sums (beyond ~10^±75 it overflows and
-/// the reliability flag would read "no" on a right answer).
-pub const MIN_SIZE: f64 = 1e-60;
-/// See [`MIN_SIZE`].
-pub const MAX_SIZE: f64 = 1e60;
-
-/// Farthest a scene's vertices may lie from the origin, in units of its
-/// size: at 10⁶ sizes a coordinate keeps about ten significant digits of
-/// the geometry, enough for every offset the tracer takes (measured
-/// exact there; at 10⁷ a moving fog's derivative drifted by 3σ, at 10⁸ by
-/// 86σ).
-pub const MAX_OFFSET: f64 = 1e6;
 
 /// Checks shape `k`: its name (`repeated`: an earlier shape has it), its
 /// vertices, its surface and its medium.
@@ -372,7 +316,7 @@ fn resolve_parameters(
     }
     let mut names = std::collections::HashSet::with_capacity(parameters.len());
     for (j, p) in parameters.iter().enumerate() {
-        super::check_parameter_name(j, &p.name, &p.shape, &super::GRADIENT_AXES)?;
+        check_parameter_name(j, &p.name, &p.shape, &GRADIENT_AXES)?;
         if !names.insert(p.name.as_str()) {
             return config(format!("two parameters are named {:?}", p.name));
         }
