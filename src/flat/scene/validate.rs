@@ -23,7 +23,7 @@ impl Scene {
     /// range (κs < 0, κe < κs, |g| ≥ 1, albedo ∉ `[0, 1]`, radiance < 0), a
     /// medium on an open or opaque shape, a transparent shape without a
     /// medium, parameters naming no shape, duplicate names, a sensor on a
-    /// segment or inside an opaque closed shape.
+    /// segment or inside an opaque closed shape other than an emitter.
     pub fn new(
         shapes: Vec<Shape>,
         parameters: Vec<Parameter>,
@@ -359,7 +359,8 @@ fn resolve_parameters(
 }
 
 /// The sensor with its direction or normal normalised; rejects a sensor
-/// that is not finite, lies on a segment or inside an opaque closed shape.
+/// that is not finite, lies on a segment or inside an opaque closed shape
+/// other than an emitter (directly: not in a box inside the emitter).
 fn check_sensor(
     sensor: Sensor,
     shapes: &[Shape],
@@ -413,15 +414,24 @@ fn check_sensor(
             ));
         }
     }
-    for s in shapes {
-        if s.closed && s.surface.is_opaque() && contains(&s.vertices, p) {
-            return config(format!(
-                "the sensor at [{}, {}] is inside the opaque shape {:?}",
-                Num(p.x),
-                Num(p.y),
-                s.name
-            ));
-        }
+    // The closed opaque polygon nearest around the sensor (shapes do not
+    // cross, so those around it nest: the least in area): an emitter is a
+    // furnace, its inner faces emitting as the outer ones (two-sided); any
+    // other is taken for a solid, which no path enters.
+    let area = |s: &Shape| signed_area(&s.vertices).abs();
+    let around = shapes
+        .iter()
+        .filter(|s| s.closed && s.surface.is_opaque() && contains(&s.vertices, p))
+        .min_by(|a, b| area(a).total_cmp(&area(b)));
+    if let Some(s) = around
+        && !matches!(s.surface, Surface::Emitter { radiance } if radiance > 0.0)
+    {
+        return config(format!(
+            "the sensor at [{}, {}] is inside the opaque shape {:?}",
+            Num(p.x),
+            Num(p.y),
+            s.name
+        ));
     }
     Ok(sensor)
 }
