@@ -22,14 +22,34 @@ the file's schema, so that a notebook can sweep a parameter by editing it
 raises :class:`ValueError` with the command line's message; the estimator's
 caveats are issued as :class:`RuntimeWarning`. The GIL is released while
 paths are sampled, so other Python threads run meanwhile.
+
+Ctrl-C stops a run called from Python's main thread (``KeyboardInterrupt``).
+Python delivers signals to its main thread only, so a run called from
+another thread (a ``threading.Thread``, a ``ThreadPoolExecutor``) is
+stopped through its ``stop``: a :class:`threading.Event` (or anything with
+``is_set()``) or a callable, looked at every 50 ms, that the main thread
+sets when it gets the ``KeyboardInterrupt``::
+
+    stop = threading.Event()
+    with ThreadPoolExecutor() as pool:
+        runs = [pool.submit(geosens.flat, s, "transport", stop=stop) for s in scenes]
+        try:
+            results = [r.result() for r in runs]
+        except KeyboardInterrupt:
+            stop.set()  # every run ends at its next chunk
+            raise
+
+A stopped run raises ``KeyboardInterrupt`` (or what the callable raised).
 """
 
 from __future__ import annotations
 
 import json
+import operator
 import os
+import threading
 import warnings
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -46,20 +66,29 @@ ShardSpec = Tuple[int, int]
 #: A shard's state: its dict, its JSON text, or the file the command line's
 #: ``--state`` wrote.
 StateLike = Union[Dict[str, Any], str, "os.PathLike[str]"]
+#: What stops a run: a :class:`threading.Event` (anything with ``is_set()``)
+#: or a callable of no argument, true to stop.
+Stop = Union[threading.Event, Callable[[], Any]]
 
 
 def _uint(name: str, value: Any) -> int:
-    """``value`` if it is an integer from 0 to 2⁶⁴ − 1, else ValueError
-    (Rust takes u64; past it, pyo3 raised an OverflowError naming nothing)."""
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, int)
-        or not 0 <= value < 2**64
-    ):
-        raise ValueError(
-            f"invalid value {value!r} for {name}: expected an integer from 0 to 2^64 - 1"
-        )
-    return value
+    """``value`` as an ``int`` if it is an integer from 0 to 2⁶⁴ − 1, else
+    ValueError. An integer is anything with ``__index__`` (numpy's
+    ``np.int64``, what a sweep over ``np.arange`` or ``np.logspace(...)
+    .astype(int)`` hands over), but not a bool: ``paths=True`` is a mistake.
+    Rust takes u64; past it, pyo3 raised an OverflowError naming nothing."""
+    bad = ValueError(
+        f"invalid value {value!r} for {name}: expected an integer from 0 to 2^64 - 1"
+    )
+    if isinstance(value, (bool, np.bool_)):
+        raise bad
+    try:
+        n = operator.index(value)
+    except TypeError:
+        raise bad from None
+    if not 0 <= n < 2**64:
+        raise bad
+    return n
 
 
 def _real(name: str, value: Any) -> float:
@@ -83,6 +112,22 @@ def _shard(shard: Optional[ShardSpec]) -> Optional[Tuple[int, int]]:
             f"shard {shard!r}: expected (i, n) with 1 ≤ i ≤ n"
         ) from None
     return (_uint("shard index", i), _uint("shard count", n))
+
+
+def _stop(stop: Optional[Stop]) -> Optional[Callable[[], Any]]:
+    """The callable the run calls every 50 ms: an event's ``is_set``, or
+    ``stop`` itself."""
+    if stop is None:
+        return None
+    is_set = getattr(stop, "is_set", None)
+    if callable(is_set):
+        return is_set
+    if callable(stop):
+        return stop
+    raise ValueError(
+        f"stop: expected a threading.Event (anything with is_set()) or a callable, "
+        f"not {type(stop).__name__}"
+    )
 
 
 def _fd_step(fd_step: Optional[float]) -> Optional[float]:
@@ -147,6 +192,7 @@ def rod(
     threads: int = 0,
     fd_step: Optional[float] = None,
     shard: Optional[ShardSpec] = None,
+    stop: Optional[Stop] = None,
 ) -> Dict[str, Any]:
     """``geosens rod --json``: I, ∂I/∂length (and ∂I/∂x) at a probe on a rod.
 
@@ -161,8 +207,15 @@ def rod(
         paths: paths of the run (at least 2, checked for ``exact`` too).
         seed: seed of the random streams.
         threads: worker threads, 0 = all cores (results do not depend on it).
+            ``paths``, ``seed``, ``threads`` and ``shard``'s numbers take any
+            integer (numpy's too: anything with ``__index__``), not a bool
+            or a float.
         fd_step: half step of ``fd`` (relative to the length).
         shard: ``(i, n)``: run shard i of n and return its state.
+        stop: a :class:`threading.Event` or a callable, looked at every
+            50 ms: once set (true), the run ends at its next chunk and
+            raises ``KeyboardInterrupt``. Ctrl-C reaches runs called from
+            the main thread only; ``stop`` stops one called from another.
 
     Returns:
         ``{"method", "intensity", "sensitivity", "gradient_x", "paths",
@@ -187,6 +240,7 @@ def rod(
             _uint("threads", threads),
             _fd_step(fd_step),
             _shard(shard),
+            _stop(stop),
         )
     )
 
@@ -200,6 +254,7 @@ def _scene_run(
     threads: int,
     fd_step: Optional[float],
     shard: Optional[ShardSpec],
+    stop: Optional[Stop],
 ) -> Dict[str, Any]:
     path, text = _scene(scene)
     return _result(
@@ -213,6 +268,7 @@ def _scene_run(
             _uint("threads", threads),
             _fd_step(fd_step),
             _shard(shard),
+            _stop(stop),
         )
     )
 
@@ -226,13 +282,14 @@ def flat(
     threads: int = 0,
     fd_step: Optional[float] = None,
     shard: Optional[ShardSpec] = None,
+    stop: Optional[Stop] = None,
 ) -> Dict[str, Any]:
     """``geosens flat --json``: I and every ∂I/∂π of a flatland scene.
 
     Args:
         scene: a scene file (TOML or JSON) or a dict of its schema.
         method: intensity, expectation, rendering, transport or fd.
-        paths, seed, threads, fd_step, shard: as for :func:`rod`.
+        paths, seed, threads, fd_step, shard, stop: as for :func:`rod`.
 
     Returns:
         ``{"method", "intensity", "sensitivity": {param: …}, "gradient"
@@ -242,7 +299,7 @@ def flat(
     Raises:
         ValueError: bad input, with the command line's message.
     """
-    return _scene_run(False, scene, method, paths, seed, threads, fd_step, shard)
+    return _scene_run(False, scene, method, paths, seed, threads, fd_step, shard, stop)
 
 
 def mesh(
@@ -254,12 +311,13 @@ def mesh(
     threads: int = 0,
     fd_step: Optional[float] = None,
     shard: Optional[ShardSpec] = None,
+    stop: Optional[Stop] = None,
 ) -> Dict[str, Any]:
     """``geosens mesh --json``: I and every ∂I/∂π of a 3D scene.
 
     As :func:`flat`; transport's gradient has the axes x, y, z.
     """
-    return _scene_run(True, scene, method, paths, seed, threads, fd_step, shard)
+    return _scene_run(True, scene, method, paths, seed, threads, fd_step, shard, stop)
 
 
 def render(
@@ -271,9 +329,12 @@ def render(
     threads: int = 0,
     fd_step: Optional[float] = None,
     shard: Optional[ShardSpec] = None,
+    stop: Optional[Stop] = None,
 ) -> Dict[str, Any]:
     """``geosens render``: every pixel of a camera scene (3D, or flatland's
-    line camera), ``spp`` paths per pixel.
+    line camera), ``spp`` paths per pixel; ``seed``, ``threads``,
+    ``fd_step``, ``shard`` and ``stop`` as for :func:`rod` (a stopped
+    rendering ends at its next pixel).
 
     Returns:
         The command line's JSON line (``"method"``, ``"I"``,
@@ -298,6 +359,7 @@ def render(
             _uint("threads", threads),
             _fd_step(fd_step),
             _shard(shard),
+            _stop(stop),
         )
     )
 

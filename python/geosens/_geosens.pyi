@@ -1,5 +1,5 @@
 # The Rust module (python/src/lib.rs); `geosens/__init__.py` wraps it.
-from typing import List, Optional, Tuple
+from typing import Any, Callable, List, Optional, Tuple
 
 # (kind, JSON text, warnings, images): kind is "report", "image" or "state";
 # an image is (key, height, width, mean bytes, stderr bytes), native float64.
@@ -10,14 +10,16 @@ __version__: str
 def rod(
     method: str, ks: float, ke: float, length: float, x: float, omega: float,
     paths: int, seed: int, threads: int, fd_step: Optional[float],
-    shard: Optional[Tuple[int, int]],
+    shard: Optional[Tuple[int, int]], stop: Optional[Callable[[], Any]],
 ) -> _Outcome: ...
 def scene(
     mesh: bool, path: Optional[str], json: Optional[str], method: str, paths: int,
     seed: int, threads: int, fd_step: Optional[float], shard: Optional[Tuple[int, int]],
+    stop: Optional[Callable[[], Any]],
 ) -> _Outcome: ...
 def render(
     path: Optional[str], json: Optional[str], method: str, spp: int, seed: int,
     threads: int, fd_step: Optional[float], shard: Optional[Tuple[int, int]],
+    stop: Optional[Callable[[], Any]],
 ) -> _Outcome: ...
 def merge(states: List[Tuple[str, Optional[str], Optional[str]]]) -> _Outcome: ...

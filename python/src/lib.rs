@@ -5,14 +5,16 @@
 //! shard's state), which `geosens/__init__.py` turns into Python objects;
 //! every bad input raises `ValueError` with the library's message, the one
 //! the command line prints after `error: `. The GIL is released while
-//! sampling, and Ctrl-C stops a run (`KeyboardInterrupt`).
+//! sampling, and Ctrl-C stops a run (`KeyboardInterrupt`), as does the
+//! caller's `stop` (a run on another thread than Python's main one, which
+//! alone sees signals).
 use geosens::image::ImageResult;
 use geosens::job::{ImageReport, Job, RenderJob, SceneSource, Target};
 use geosens::report::Report;
 use geosens::runner::Progress;
 use geosens::shard::{Merged, Shard, State, merge as merge_states};
 use geosens::{Error, Method, Quantity, RunConfig};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::path::PathBuf;
@@ -91,19 +93,24 @@ fn source(path: Option<PathBuf>, json: Option<String>) -> PyResult<SceneSource> 
     }
 }
 
-/// Runs `work` on a thread of its own while the caller's (Python's main)
-/// thread, the GIL released, looks for signals every 50 ms: Python runs its
-/// signal handlers only there, and only between bytecodes. On Ctrl-C the
-/// run stops at its next chunk (a rendering's: pixel) through its progress hook, and the
-/// handler's exception (`KeyboardInterrupt`) is raised here once the
-/// chunks under way have ended.
+/// Runs `work` on a thread of its own while the calling thread, the GIL
+/// released, looks every 50 ms for signals and calls `stop` (a callable,
+/// true to stop). Python runs its signal handlers on its main thread only,
+/// between bytecodes, so Ctrl-C reaches a run called from there; a run
+/// called from another thread is stopped through `stop`, which the caller
+/// sets when its main thread gets the `KeyboardInterrupt`. Either way the
+/// run stops at its next chunk (a rendering's: pixel) through its progress
+/// hook, and the exception (the signal handler's, `stop`'s own if calling
+/// it raised, else `KeyboardInterrupt`) is raised here once the chunks
+/// under way have ended.
 fn interruptible<T: Send>(
     py: Python<'_>,
+    stop: Option<&Py<PyAny>>,
     work: impl FnOnce(Progress) -> Result<T, Error> + Send,
 ) -> PyResult<Result<T, Error>> {
-    let stop = AtomicBool::new(false);
+    let stopping = AtomicBool::new(false);
     let hook = |_done: u64| {
-        if stop.load(Ordering::Relaxed) {
+        if stopping.load(Ordering::Relaxed) {
             Err(Error::Stopped("interrupted".into()))
         } else {
             Ok(())
@@ -131,11 +138,11 @@ fn interruptible<T: Send>(
             if waited != Err(mpsc::RecvTimeoutError::Timeout) {
                 break;
             }
-            if signal.is_none()
-                && let Err(e) = py.check_signals()
-            {
-                stop.store(true, Ordering::Relaxed);
-                signal = Some(e);
+            if signal.is_none() {
+                signal = py.check_signals().err().or_else(|| stopped(py, stop));
+                if signal.is_some() {
+                    stopping.store(true, Ordering::Relaxed);
+                }
             }
         }
         let out = py
@@ -145,8 +152,21 @@ fn interruptible<T: Send>(
     })
 }
 
+/// The exception that stops a run if the caller's `stop` says so (true,
+/// or raising): see [`interruptible`].
+fn stopped(py: Python<'_>, stop: Option<&Py<PyAny>>) -> Option<PyErr> {
+    match stop?.bind(py).call0().and_then(|v| v.is_truthy()) {
+        Ok(false) => None,
+        Ok(true) => Some(PyKeyboardInterrupt::new_err(
+            "the run was stopped: its stop was set",
+        )),
+        Err(e) => Some(e),
+    }
+}
+
 /// Runs `job` on `paths` paths, or its shard `shard = (i, n)`, without the
-/// GIL, stopping at Ctrl-C ([`interruptible`]).
+/// GIL, stopping at Ctrl-C or at `stop` ([`interruptible`]).
+#[allow(clippy::too_many_arguments)]
 fn estimate(
     py: Python<'_>,
     job: Job,
@@ -154,8 +174,9 @@ fn estimate(
     seed: u64,
     threads: usize,
     shard: Option<(u64, u64)>,
+    stop: Option<Py<PyAny>>,
 ) -> PyResult<Outcome> {
-    let out = interruptible(py, |progress| -> Result<Output, Error> {
+    let out = interruptible(py, stop.as_ref(), |progress| -> Result<Output, Error> {
         let cfg = RunConfig::new(paths, seed)?.threads(threads);
         match shard {
             None => job.run(&cfg, progress).map(Output::Report),
@@ -169,7 +190,7 @@ fn estimate(
 
 /// `geosens rod`: `method` is a method's name or `exact`.
 #[pyfunction]
-#[pyo3(signature = (method, ks, ke, length, x, omega, paths, seed, threads, fd_step, shard))]
+#[pyo3(signature = (method, ks, ke, length, x, omega, paths, seed, threads, fd_step, shard, stop))]
 #[allow(clippy::too_many_arguments)]
 fn rod(
     py: Python<'_>,
@@ -184,6 +205,7 @@ fn rod(
     threads: usize,
     fd_step: Option<f64>,
     shard: Option<(u64, u64)>,
+    stop: Option<Py<PyAny>>,
 ) -> PyResult<Outcome> {
     // `exact` beside the methods, as the command line's `--method` lists
     // them.
@@ -199,13 +221,13 @@ fn rod(
         method,
         fd_step,
     };
-    estimate(py, job, paths, seed, threads, shard)
+    estimate(py, job, paths, seed, threads, shard, stop)
 }
 
 /// `geosens flat` (`mesh = false`) or `geosens mesh` on a scene file
 /// (`path`) or JSON text (`json`).
 #[pyfunction]
-#[pyo3(signature = (mesh, path, json, method, paths, seed, threads, fd_step, shard))]
+#[pyo3(signature = (mesh, path, json, method, paths, seed, threads, fd_step, shard, stop))]
 #[allow(clippy::too_many_arguments)]
 fn scene(
     py: Python<'_>,
@@ -218,6 +240,7 @@ fn scene(
     threads: usize,
     fd_step: Option<f64>,
     shard: Option<(u64, u64)>,
+    stop: Option<Py<PyAny>>,
 ) -> PyResult<Outcome> {
     let method = method.parse::<Method>().map_err(value_error)?;
     let source = source(path, json)?;
@@ -230,13 +253,13 @@ fn scene(
         method: Some(method),
         fd_step,
     };
-    estimate(py, job, paths, seed, threads, shard)
+    estimate(py, job, paths, seed, threads, shard, stop)
 }
 
 /// `geosens render` on a scene file (`path`) or JSON text (`json`), or its
 /// shard `shard = (i, n)`.
 #[pyfunction]
-#[pyo3(signature = (path, json, method, spp, seed, threads, fd_step, shard))]
+#[pyo3(signature = (path, json, method, spp, seed, threads, fd_step, shard, stop))]
 #[allow(clippy::too_many_arguments)]
 fn render(
     py: Python<'_>,
@@ -248,6 +271,7 @@ fn render(
     threads: usize,
     fd_step: Option<f64>,
     shard: Option<(u64, u64)>,
+    stop: Option<Py<PyAny>>,
 ) -> PyResult<Outcome> {
     let method = method.parse::<Method>().map_err(value_error)?;
     let job = RenderJob {
@@ -255,7 +279,7 @@ fn render(
         method,
         fd_step,
     };
-    let out = interruptible(py, |progress| -> Result<Output, Error> {
+    let out = interruptible(py, stop.as_ref(), |progress| -> Result<Output, Error> {
         geosens::runner::check_threads(threads)?;
         match shard {
             None => job.run(spp, seed, threads, progress).map(Output::Image),

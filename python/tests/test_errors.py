@@ -101,3 +101,25 @@ def test_python_side_checks():
     assert "fd_step" in raises(geosens.flat, OCC, "fd", fd_step="0.01")
     with pytest.raises(ValueError, match="not a geosens state"):
         geosens.merge([{"a": 1}])
+
+
+def test_a_parameter_named_like_another_quantity_is_refused(tmp_path, cli):
+    """A parameter named ``I`` took the key of the intensity's image (the
+    images came back as ``['I', 'rot']``, the intensity's gone); one named
+    ``x`` printed a second ``∂I/∂x`` row beside the sensor gradient's."""
+    import tomllib
+
+    for path, old, new in [(SCENES / "camera_line.toml", "tx", "I"), (OCC, "occluder_tx", "x")]:
+        text = path.read_text().replace(f'name = "{old}"', f'name = "{new}"')
+        scene = tomllib.loads(text)
+        renamed = tmp_path / path.name
+        renamed.write_text(text)
+        if new == "I":
+            msg = raises(geosens.render, scene, "rendering", spp=4)
+            err = cli.error("render", "--scene", renamed, "--method", "rendering",
+                            "--spp", 4, "--out", tmp_path / "out")
+        else:
+            msg = raises(geosens.flat, scene, "transport", paths=1000)
+            err = cli.error("flat", "--scene", renamed, "--method", "transport")
+        assert f'parameter "{new}" has the name of' in msg
+        assert err == msg.replace("invalid scene: ", f"invalid scene: {renamed}: ")

@@ -105,8 +105,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
         .map(|p| Quantity::sensitivity(&p.name))
         .collect();
     if gradient {
-        names.push(Quantity::gradient("x"));
-        names.push(Quantity::gradient("y"));
+        names.extend(super::scene::GRADIENT_AXES.map(Quantity::gradient));
     }
     // Transport's twins serve moving reflectors only (elsewhere they would
     // be slots carried for nothing).

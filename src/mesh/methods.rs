@@ -184,7 +184,7 @@ fn crosses(v: glam::DVec3, n: glam::DVec3) -> bool {
 }
 
 /// The sensor's axes, as transport's gradient names them.
-const AXES: [(&str, glam::DVec3); 3] = [
+pub(crate) const AXES: [(&str, glam::DVec3); 3] = [
     ("x", glam::DVec3::X),
     ("y", glam::DVec3::Y),
     ("z", glam::DVec3::Z),

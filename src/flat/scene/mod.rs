@@ -5,8 +5,9 @@
 //! rules); the path tracer then never meets a degenerate configuration.
 //!
 //! This file holds the data types and the validated [`Scene`] with its
-//! accessors; `validate` builds a scene step by step and `repr` holds the
-//! file forms of the tagged enums.
+//! accessors; `validate` builds a scene step by step (with the checks in
+//! `shared`, which 3D's validation uses too) and `repr` holds the file
+//! forms of the tagged enums.
 use super::corners::CornerTree;
 use super::geometry::{NO_SEGMENT, RayCast, Segment, perp};
 use crate::error::Error;
@@ -14,14 +15,15 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 mod repr;
+mod shared;
 #[cfg(test)]
 mod tests;
 mod touch;
 mod validate;
 
-pub(crate) use validate::check_extent;
-pub(crate) use validate::check_pivot;
-pub use validate::{MAX_OFFSET, MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE};
+pub(crate) use shared::{GRADIENT_AXES, check_extent, check_parameter_name, check_pivot};
+pub use shared::{MAX_OFFSET, MAX_SIZE, MIN_SIZE};
+pub use validate::MAX_SCATTERING_EVENTS;
 
 /// Largest extinction coefficient times scene size accepted: beyond it a
 /// medium is opaque for every purpose and the weights underflow.

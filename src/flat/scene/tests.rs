@@ -72,7 +72,7 @@ fn bad_scenes_are_rejected_with_a_reason() {
     });
     assert!(err(vec![fog], vec![], irradiance()).contains("κe"));
     let p = Parameter {
-        name: "x".into(),
+        name: "p".into(),
         shape: "nope".into(),
         motion: Motion::TranslateX,
     };

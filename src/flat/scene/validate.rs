@@ -5,8 +5,9 @@
 //! parameters, sensor, media), so a scene with several faults always reports
 //! the first of them.
 use super::{
-    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion,
-    Parameter, Phase, Scene, Sensor, Shape, Surface, config,
+    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, GRADIENT_AXES, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS,
+    Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface, check_extent,
+    check_parameter_name, check_pivot, config,
 };
 use crate::error::{Error, Num};
 use crate::flat::corners::CornerTree;
@@ -22,7 +23,7 @@ impl Scene {
     /// range (κs < 0, κe < κs, |g| ≥ 1, albedo ∉ `[0, 1]`, radiance < 0), a
     /// medium on an open or opaque shape, a transparent shape without a
     /// medium, parameters naming no shape, duplicate names, a sensor on a
-    /// segment or inside an opaque closed shape.
+    /// segment or inside an opaque closed shape other than an emitter.
     pub fn new(
         shapes: Vec<Shape>,
         parameters: Vec<Parameter>,
@@ -118,63 +119,6 @@ fn check_shapes(shapes: &[Shape]) -> Result<f64, Error> {
         lo.abs().max(hi.abs()).max_element(),
     )
 }
-
-/// A scene's size (the largest extent of its vertices' bounding box) within
-/// [`MIN_SIZE`]..[`MAX_SIZE`], and `far`, its farthest coordinate from the
-/// origin, within [`MAX_OFFSET`] times it; returns the size. Flatland's
-/// and 3D's validation both.
-pub(crate) fn check_extent(size: f64, far: f64) -> Result<f64, Error> {
-    if !(MIN_SIZE..=MAX_SIZE).contains(&size) {
-        return config(format!(
-            "the scene's size (largest extent of its vertices' bounding box) is {size:e}: \
-             sizes from {MIN_SIZE:e} to {MAX_SIZE:e} are supported; rescale the scene \
-             (only κ × size and ratios of lengths matter)"
-        ));
-    }
-    if far > MAX_OFFSET * size {
-        return config(format!(
-            "the scene lies {far:e} from the origin, {:.1e} times its size {size:e}: \
-             at most {MAX_OFFSET:e} times is supported (farther, its coordinates keep \
-             too few digits of its geometry); move the scene nearer the origin",
-            far / size
-        ));
-    }
-    Ok(size)
-}
-
-/// Refuses a pivot farther than [`MAX_OFFSET`] sizes from the shape it
-/// turns or scales (`distance`, along the farthest axis: a length would
-/// overflow): the motion's velocities grow with that
-/// distance, and past it a rotation read 0 with no warning (pivot 10¹⁶⁰
-/// away) or its diagnostics NaN (10¹⁰⁰). Flatland's and 3D's validation
-/// both.
-pub(crate) fn check_pivot(name: &str, distance: f64, size: f64) -> Result<(), Error> {
-    if distance > MAX_OFFSET * size {
-        return config(format!(
-            "parameter {name:?}: its pivot lies {distance:e} from the shape it moves, {:.1e} \
-             times the scene's size {size:e}: at most {MAX_OFFSET:e} times is supported \
-             (such a rotation or scale is a translation of enormous speed)",
-            distance / size
-        ));
-    }
-    Ok(())
-}
-
-/// Smallest and largest scene size accepted: within them every squared
-/// length and cross product the tracer forms is a normal float, and so is
-/// the fourth power of a translation's weight (∝ 1/size) that the
-/// variance-of-the-variance diagnostic sums (beyond ~10^±75 it overflows and
-/// the reliability flag would read "no" on a right answer).
-pub const MIN_SIZE: f64 = 1e-60;
-/// See [`MIN_SIZE`].
-pub const MAX_SIZE: f64 = 1e60;
-
-/// Farthest a scene's vertices may lie from the origin, in units of its
-/// size: at 10⁶ sizes a coordinate keeps about ten significant digits of
-/// the geometry, enough for every offset the tracer takes (measured
-/// exact there; at 10⁷ a moving fog's derivative drifted by 3σ, at 10⁸ by
-/// 86σ).
-pub const MAX_OFFSET: f64 = 1e6;
 
 /// Checks shape `k`: its name (`repeated`: an earlier shape has it), its
 /// vertices, its surface and its medium.
@@ -372,9 +316,7 @@ fn resolve_parameters(
     }
     let mut names = std::collections::HashSet::with_capacity(parameters.len());
     for (j, p) in parameters.iter().enumerate() {
-        if p.name.is_empty() {
-            return config(format!("parameter {j} has an empty name"));
-        }
+        check_parameter_name(j, &p.name, &p.shape, &GRADIENT_AXES)?;
         if !names.insert(p.name.as_str()) {
             return config(format!("two parameters are named {:?}", p.name));
         }
@@ -417,7 +359,8 @@ fn resolve_parameters(
 }
 
 /// The sensor with its direction or normal normalised; rejects a sensor
-/// that is not finite, lies on a segment or inside an opaque closed shape.
+/// that is not finite, lies on a segment or inside an opaque closed shape
+/// other than an emitter (directly: not in a box inside the emitter).
 fn check_sensor(
     sensor: Sensor,
     shapes: &[Shape],
@@ -471,15 +414,24 @@ fn check_sensor(
             ));
         }
     }
-    for s in shapes {
-        if s.closed && s.surface.is_opaque() && contains(&s.vertices, p) {
-            return config(format!(
-                "the sensor at [{}, {}] is inside the opaque shape {:?}",
-                Num(p.x),
-                Num(p.y),
-                s.name
-            ));
-        }
+    // The closed opaque polygon nearest around the sensor (shapes do not
+    // cross, so those around it nest: the least in area): an emitter is a
+    // furnace, its inner faces emitting as the outer ones (two-sided); any
+    // other is taken for a solid, which no path enters.
+    let area = |s: &Shape| signed_area(&s.vertices).abs();
+    let around = shapes
+        .iter()
+        .filter(|s| s.closed && s.surface.is_opaque() && contains(&s.vertices, p))
+        .min_by(|a, b| area(a).total_cmp(&area(b)));
+    if let Some(s) = around
+        && !matches!(s.surface, Surface::Emitter { radiance } if radiance > 0.0)
+    {
+        return config(format!(
+            "the sensor at [{}, {}] is inside the opaque shape {:?}",
+            Num(p.x),
+            Num(p.y),
+            s.name
+        ));
     }
     Ok(sensor)
 }

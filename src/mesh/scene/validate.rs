@@ -26,7 +26,7 @@ use super::{
     MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion, Parameter, Scene, Sensor, Shape, Surface,
 };
 use crate::error::{Error, Num};
-use crate::flat::scene::MAX_SCATTERING_EVENTS;
+use crate::flat::scene::{MAX_SCATTERING_EVENTS, check_parameter_name};
 use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 
@@ -98,7 +98,7 @@ impl Scene {
     /// bad parameters (too many, empty or
     /// repeated names, unknown shapes, zero or non-finite axes and pivots),
     /// a non-finite sensor, a sensor on a surface or inside an opaque closed
-    /// mesh.
+    /// mesh that is no emitter and holds none.
     pub fn new(
         mut shapes: Vec<Shape>,
         parameters: Vec<Parameter>,
@@ -411,9 +411,12 @@ fn resolve_parameters(
     let mut resolved = Vec::with_capacity(parameters.len());
     let mut names = HashSet::with_capacity(parameters.len());
     for (j, p) in parameters.iter().enumerate() {
-        if p.name.is_empty() {
-            return config(format!("parameter {j} has an empty name"));
-        }
+        check_parameter_name(
+            j,
+            &p.name,
+            &p.shape,
+            &crate::mesh::methods::AXES.map(|a| a.0),
+        )?;
         if !names.insert(p.name.as_str()) {
             return config(format!("two parameters are named {:?}", p.name));
         }
@@ -457,8 +460,8 @@ pub(super) fn inside(s: &Shape, p: DVec3) -> bool {
 
 /// The sensor with its direction or normal normalised; rejects a sensor
 /// that is not finite, lies on a triangle (closer than `SENSOR_DISTANCE` ×
-/// `size`) or inside an opaque closed mesh that holds no emitter (inside
-/// one that does is a room).
+/// `size`) or inside an opaque closed mesh that holds no emitter and is
+/// none (inside one that does is a room).
 fn check_sensor(
     sensor: Sensor,
     shapes: &[Shape],
@@ -501,14 +504,15 @@ fn check_sensor(
     }
     // Inside a closed opaque mesh is a room (two-sided surfaces: its inner
     // walls are as good as its outer ones), unless no emitter is inside
-    // with the sensor: then it sees nothing, a mistake.
+    // with the sensor: then it sees nothing, a mistake. A closed emitter
+    // lights its own inside.
+    let glows = |e: &Shape| matches!(e.surface, Surface::Emitter { radiance } if radiance > 0.0);
     for (k, s) in shapes.iter().enumerate() {
         if closed[k] && s.surface.is_opaque() && inside(s, p) {
-            let lit = shapes.iter().enumerate().any(|(l, e)| {
-                l != k
-                    && matches!(e.surface, Surface::Emitter { radiance } if radiance > 0.0)
-                    && e.vertices.first().is_some_and(|&v| inside(s, v))
-            });
+            let lit = glows(s)
+                || shapes.iter().enumerate().any(|(l, e)| {
+                    l != k && glows(e) && e.vertices.first().is_some_and(|&v| inside(s, v))
+                });
             if !lit {
                 return config(format!(
                     "the sensor at {} is inside the opaque shape {:?}, which holds no \
