@@ -439,6 +439,8 @@ fn sha256(text: &str) -> String {
 
 mod merge;
 pub use merge::{Merged, merge};
+mod survey;
+pub use survey::{Survey, array_spec, survey};
 
 #[cfg(test)]
 mod tests;

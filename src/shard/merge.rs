@@ -202,7 +202,7 @@ fn misplaced(s: &State, first: &State) -> Option<String> {
 }
 
 /// Which fields of two run identities differ, for a message.
-fn differences(a: &RunId, b: &RunId) -> String {
+pub(super) fn differences(a: &RunId, b: &RunId) -> String {
     let mut d = Vec::new();
     if a.method != b.method {
         d.push(format!("method {} against {}", a.method, b.method));
