@@ -420,3 +420,48 @@ fn shard_arguments_are_checked() {
     assert!(refused(&exact).contains("samples nothing"));
     assert!(!Path::new(state).exists(), "a refused run wrote a state");
 }
+
+#[test]
+fn a_line_camera_spreads_over_every_shard() {
+    // One row of 40 pixels over 7 shards: split by rows, six shards held
+    // nothing and one did all the work; split by pixels each holds 5 or 6.
+    let scene = repo("scenes/camera_line.toml");
+    let dir = scratch("line");
+    let base = [
+        "render",
+        "--scene",
+        &scene,
+        "--method",
+        "expectation",
+        "--spp",
+        "32",
+        "--seed",
+        "9",
+    ];
+    let files = shards(&base, 7, &dir);
+    let mut pixels = 0;
+    for f in &files {
+        let state = State::read(Path::new(f)).unwrap();
+        let held = state.paths / 32;
+        assert!((5..=6).contains(&held), "{f}: {held} pixels");
+        pixels += held;
+    }
+    assert_eq!(pixels, 40);
+    let (single_dir, merged_dir) = (dir.join("single"), dir.join("merged"));
+    let mut single = base.to_vec();
+    single.extend(["--out", single_dir.to_str().unwrap()]);
+    let a = ok(&single);
+    let mut args = vec!["merge", "--out", merged_dir.to_str().unwrap()];
+    args.extend(files.iter().map(String::as_str));
+    assert_eq!(without_seconds(&a), without_seconds(&ok(&args)));
+    for name in ["I.npy", "I_stderr.npy", "d_tx.npy", "d_rot_stderr.npy"] {
+        assert_eq!(
+            std::fs::read(single_dir.join(name)).unwrap(),
+            std::fs::read(merged_dir.join(name)).unwrap(),
+            "{name}"
+        );
+    }
+    // The help says what a rendering's shard is.
+    let help = ok(&["render", "--help"]);
+    assert!(help.contains("pixels") && !help.contains("65536"), "{help}");
+}

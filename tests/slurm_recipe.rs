@@ -282,6 +282,52 @@ fn a_failed_shard_is_rerun_alone_and_the_merge_is_the_single_run() {
 }
 
 #[test]
+fn a_rendering_through_the_slurm_scripts_is_the_single_rendering() {
+    let scene = repo("scenes/camera_line.toml");
+    let run = [
+        ("KIND", "render"),
+        ("SCENE", scene.as_str()),
+        ("METHOD", "rendering"),
+        ("SPP", "32"),
+        ("SEED", "4"),
+        ("SHARDS", "5"),
+    ];
+    let r = Recipe::new("render", &run);
+    for task in ["2", "5", "1", "4", "3"] {
+        r.ok("shards.sbatch", &[("SLURM_ARRAY_TASK_ID", task)]);
+    }
+    let merged = r.ok("merge.sbatch", &[]);
+    let out = geosens(
+        &r.dir,
+        &[
+            "render",
+            "--scene",
+            &scene,
+            "--method",
+            "rendering",
+            "--spp",
+            "32",
+            "--seed",
+            "4",
+            "--out",
+            "single",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(
+        without_seconds(&merged),
+        without_seconds(&text(&out.stdout))
+    );
+    for name in ["I.npy", "I_stderr.npy", "d_tx.npy", "d_rot.npy"] {
+        assert_eq!(
+            std::fs::read(r.dir.join("single").join(name)).unwrap(),
+            std::fs::read(r.dir.join("images").join(name)).unwrap(),
+            "{name}"
+        );
+    }
+}
+
+#[test]
 fn merge_missing_lists_the_absent_shards_of_one_run() {
     let dir = scratch("missing");
     let scene = repo("scenes/occluder.toml");

@@ -12,7 +12,7 @@ runs on a worker and returns its exact state (a dict of integers);
 ``geosens.merge`` folds them in the run's own order, so the result is the
 single run's whatever the number of shards, workers or threads (``--check``
 runs it here and compares). A rendering's images go to ``--out`` as ``.npy``
-files. The scene travels to the workers as a dict, so they need geosens
+files named as ``geosens render`` names them. The scene travels to the workers as a dict, so they need geosens
 installed but not the file (a 3D scene's OBJ files excepted: the workers
 read those, relative to their working folder).
 """
@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 import uuid
 from pathlib import Path
@@ -117,6 +118,16 @@ def same(a: Dict[str, Any], b: Dict[str, Any]) -> bool:
     )
 
 
+def npy_stem(key: str) -> str:
+    """The command line's file name of an image (``geosens render --out``):
+    ``I``, ``d_<param>``, ``grad_<axis>``, other characters than letters,
+    digits, ``-`` and ``_`` as ``_``."""
+    if key == "I":
+        return key
+    stem = f"grad_{key[4:]}" if key.startswith("∂I/∂") else f"d_{key}"
+    return re.sub(r"[^A-Za-z0-9_-]", "_", stem)
+
+
 def main(argv: Optional[list] = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("scheduler", nargs="?", help="scheduler address (default: a LocalCluster)")
@@ -151,7 +162,7 @@ def main(argv: Optional[list] = None) -> int:
         out.mkdir(parents=True, exist_ok=True)
         for q, image in images.items():
             for k, a in image.items():
-                np.save(out / f"{q}{'_stderr' if k == 'stderr' else ''}.npy", a)
+                np.save(out / f"{npy_stem(q)}{'_stderr' if k == 'stderr' else ''}.npy", a)
     if args.check:
         single = KINDS[args.kind](scene, args.method, seed=args.seed, **size)
         ok = same(dict(merged, images=images), single)

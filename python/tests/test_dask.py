@@ -14,7 +14,7 @@ import importlib.util
 import os
 
 import pytest
-from conftest import REPO, SCENES, assert_same
+from conftest import REPO, SCENES, assert_same, image_bytes
 
 import geosens
 
@@ -83,3 +83,19 @@ def test_two_runs_at_once_on_one_scheduler_get_their_own_results():
         assert_same(got, single)
     assert ra["intensity"]["mean"] != rb["intensity"]["mean"]
 
+
+
+def test_a_rendering_on_a_cluster_is_the_single_rendering():
+    """A line camera (one row of 40 pixels) over five shards: every shard
+    holds pixels, and the merged images are the single rendering's bytes."""
+    ex = example()
+    scene = ex.load_scene(str(SCENES / "camera_line.toml"))
+    with scheduler() as address, client(address) as c:
+        states = c.gather(
+            ex.submit_shards(c, "render", scene, "rendering", shards=5, spp=32, seed=4, threads=1)
+        )
+    assert all(s["paths"] > 0 for s in states), [s["paths"] for s in states]
+    merged = geosens.merge(states)
+    single = geosens.render(scene, "rendering", spp=32, seed=4)
+    assert_same(merged, single)
+    assert image_bytes(merged) == image_bytes(single)
