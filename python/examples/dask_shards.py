@@ -54,8 +54,8 @@ def submit_shards(
     method: str,
     *,
     shards: int,
-    paths: Optional[int] = None,
-    spp: Optional[int] = None,
+    paths: int = 1_000_000,
+    spp: int = 64,
     seed: int = 1,
     threads: int = 0,
     fd_step: Optional[float] = None,
@@ -68,7 +68,6 @@ def submit_shards(
     if kind not in KINDS:
         raise ValueError(f"kind {kind!r}: expected one of {', '.join(KINDS)}")
     size = {"spp": spp} if kind == "render" else {"paths": paths}
-    size = {k: v for k, v in size.items() if v is not None}
     # A task's key is what the scheduler knows it by: two tasks submitted
     # under one key are one task, and the second client gets the first's
     # result. Shard i of n of another scene, method or path count is another
