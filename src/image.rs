@@ -152,38 +152,60 @@ pub fn check_image_memory(
     }
 }
 
-/// Renders rows `rows` of `est`'s camera, `spp` paths per pixel from
-/// `seed` on `threads` threads (0: all cores); `progress` is called with
-/// the number of pixels done after each pixel, and its error stops the
-/// rendering at the next pixel ([`Progress`]). Returns, per pixel of those rows
-/// (row-major) and per quantity, its [`PixelSums`], and the wall time. A
-/// pixel's samples depend on its index only, so any split of the rows gives
-/// the same pixels. Errors as [`render`].
-pub fn render_rows(
+/// Renders pixels `pixels` (row-major indices, row 0 at the top) of
+/// `est`'s camera, `spp` paths per pixel from `seed` on `threads` threads
+/// (0: all cores); `progress` is called with the number of pixels done
+/// after each pixel, and its error stops the rendering at the next pixel
+/// ([`Progress`]). Returns, per pixel of the range and per quantity, its
+/// [`PixelSums`], and the wall time. A pixel's samples depend on its index
+/// only, so any split of the pixels (a shard's share of an image, even of a
+/// single row) gives the same pixels. Errors as [`render`], and for a range
+/// past the image's last pixel.
+pub fn render_pixels(
     est: &dyn Estimator,
     spp: u64,
     seed: u64,
     threads: usize,
-    rows: std::ops::Range<u32>,
+    pixels: std::ops::Range<u64>,
     progress: Progress,
 ) -> Result<(Vec<Vec<PixelSums>>, f64), Error> {
-    let (width, _) = image_size(est, spp)?;
+    let (width, height) = image_size(est, spp)?;
     crate::runner::check_threads(threads)?;
+    let all = u64::from(width) * u64::from(height);
+    if pixels.start > pixels.end || pixels.end > all {
+        return Err(Error::Config(format!(
+            "pixels {}..{}: the image has {all}",
+            pixels.start, pixels.end
+        )));
+    }
     let nq = est.quantities().len();
-    let pixels = u64::from(width) * u64::from(rows.end.saturating_sub(rows.start));
-    check_image_memory(pixels, nq, available_memory())?;
+    check_image_memory(pixels.end - pixels.start, nq, available_memory())?;
     let done = std::sync::atomic::AtomicU64::new(0);
     let stop = Stop::default();
-    let row = |r: u32| -> Vec<Vec<PixelSums>> {
-        let mut out = Vec::with_capacity(width as usize);
-        for c in 0..width {
+    // The range in pieces of at most a row (cut at row starts): the unit of
+    // work a thread takes, as rows were before an image could be split.
+    let width = u64::from(width);
+    let piece = |k: u64| -> std::ops::Range<u64> {
+        let start = pixels.start.max(k * width);
+        start..pixels.end.min((k + 1) * width)
+    };
+    let pieces = if pixels.is_empty() {
+        0..0
+    } else {
+        pixels.start / width..(pixels.end - 1) / width + 1
+    };
+    let run = |k: u64| -> Vec<Vec<PixelSums>> {
+        let range = piece(k);
+        let mut out = Vec::with_capacity((range.end - range.start) as usize);
+        for p in range {
             if stop.stopping() {
                 break;
             }
-            let p = r * width + c;
-            let mut rng = rng::stream(seed, p as u64);
+            let mut rng = rng::stream(seed, p);
             let mut sums = vec![StratumSums::default(); nq];
-            est.accumulate_pixel(&mut rng, p, spp, &mut sums);
+            // An image's pixels are fewer than 2³² (a side is at most
+            // `mesh::camera::MAX_SIDE` = 8192 pixels).
+            est.accumulate_pixel(&mut rng, p as u32, spp, &mut sums);
             out.push(sums.iter().map(PixelSums::of).collect());
             stop.check(progress(
                 done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
@@ -191,15 +213,15 @@ pub fn render_rows(
         }
         out
     };
-    let (rows, seconds) = crate::runner::timed_on(threads, || -> Vec<Vec<Vec<PixelSums>>> {
+    let (pieces, seconds) = crate::runner::timed_on(threads, || -> Vec<Vec<Vec<PixelSums>>> {
         if threads == 1 {
-            rows.map(row).collect()
+            pieces.map(run).collect()
         } else {
-            rows.into_par_iter().map(row).collect()
+            pieces.into_par_iter().map(run).collect()
         }
     })?;
     stop.into_result()?;
-    Ok((rows.into_iter().flatten().collect(), seconds))
+    Ok((pieces.into_iter().flatten().collect(), seconds))
 }
 
 /// The images of every pixel's sums (`pixels`: row-major, all of them),
@@ -261,7 +283,8 @@ pub fn render(
     progress: Progress,
 ) -> Result<ImageResult, Error> {
     let size = image_size(est, spp)?;
-    let (pixels, seconds) = render_rows(est, spp, seed, threads, 0..size.1, progress)?;
+    let all = u64::from(size.0) * u64::from(size.1);
+    let (pixels, seconds) = render_pixels(est, spp, seed, threads, 0..all, progress)?;
     Ok(assemble(
         est.method(),
         est.quantities(),

@@ -15,7 +15,7 @@
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::flat::file::read_bytes_capped;
-use crate::image::{PixelSums, assemble, render_rows};
+use crate::image::{PixelSums, assemble, render_pixels};
 use crate::job::{ImageReport, Job, RenderJob};
 use crate::method::Method;
 use crate::report::{Header, Report};
@@ -144,15 +144,16 @@ pub enum Payload {
         /// Per block (from `first`), per quantity, the packed moments.
         moments: Vec<Vec<Packed>>,
     },
-    /// A rendering: its rows' pixels.
+    /// A rendering: its share of the image's pixels (a contiguous range in
+    /// row-major order, so that even a single row splits over shards).
     Rows {
-        /// The shard's first row.
+        /// The shard's first pixel (row-major index, row 0 at the top).
         first: u32,
         /// Pixels per row.
         width: u32,
         /// Rows of the whole image.
         height: u32,
-        /// Per pixel of the shard's rows (row-major), per quantity: the
+        /// Per pixel of the shard's range (row-major), per quantity: the
         /// packed pooled moments, then the bits of the pixel's mean and
         /// standard error.
         pixels: Vec<Vec<PackedPixel>>,
@@ -377,9 +378,10 @@ impl Job {
 }
 
 impl RenderJob {
-    /// Renders shard `shard` of the image (its share of the rows) with
-    /// `spp` paths per pixel from `seed` on `threads` threads, and returns
-    /// its state; `progress` is called with the shard's pixels done.
+    /// Renders shard `shard` of the image (its share of the pixels, a
+    /// contiguous range in row-major order) with `spp` paths per pixel from
+    /// `seed` on `threads` threads, and returns its state; `progress` is
+    /// called with the shard's pixels done.
     pub fn run_shard(
         &self,
         spp: u64,
@@ -392,10 +394,9 @@ impl RenderJob {
         let Some((width, height)) = est.image() else {
             unreachable!("prepare checks the camera")
         };
-        let range = shard.blocks(u64::from(height));
-        let rows = range.start as u32..range.end as u32;
+        let range = shard.blocks(u64::from(width) * u64::from(height));
         let (pixels, seconds) =
-            render_rows(est.as_ref(), spp, seed, threads, rows.clone(), progress)?;
+            render_pixels(est.as_ref(), spp, seed, threads, range.clone(), progress)?;
         Ok(State {
             format: STATE_FORMAT.to_owned(),
             version: env!("CARGO_PKG_VERSION").to_owned(),
@@ -415,7 +416,8 @@ impl RenderJob {
             caveats: est.caveats(),
             quantities: est.quantities(),
             payload: Payload::Rows {
-                first: rows.start,
+                // Below 2³²: a side is at most `mesh::camera::MAX_SIDE`.
+                first: range.start as u32,
                 width,
                 height,
                 pixels: pixels
@@ -423,7 +425,7 @@ impl RenderJob {
                     .map(|p| p.iter().map(pack_pixel).collect())
                     .collect(),
             },
-            paths: spp * u64::from(width) * u64::from(rows.end - rows.start),
+            paths: spp * (range.end - range.start),
             seconds,
         })
     }
@@ -439,6 +441,8 @@ fn sha256(text: &str) -> String {
 
 mod merge;
 pub use merge::{Merged, merge};
+mod survey;
+pub use survey::{Survey, array_spec, survey};
 
 #[cfg(test)]
 mod tests;

@@ -422,53 +422,46 @@ fn shard_arguments_are_checked() {
 }
 
 #[test]
-fn the_slurm_scripts_shard_and_merge() {
-    // The array tasks and the merge job run as Slurm would run them (the
-    // `#SBATCH` lines are comments to bash), with the task variables set.
-    let dir = scratch("slurm");
-    let scene = repo("scenes/reflector.toml");
-    let script = |name: &str| repo(&format!("examples/slurm/{name}"));
-    let (states, result) = (dir.join("states"), dir.join("result.json"));
-    let env = [
-        ("GEOSENS", env!("CARGO_BIN_EXE_geosens")),
-        ("SCENE", scene.as_str()),
-        ("METHOD", "rendering"),
-        ("PATHS", "250000"),
-        ("SEED", "8"),
-        ("STATES", states.to_str().unwrap()),
-        ("RESULT", result.to_str().unwrap()),
-        ("SLURM_ARRAY_TASK_COUNT", "4"),
-        ("SLURM_CPUS_PER_TASK", "1"),
-    ];
-    let bash = |file: String, task: Option<&str>| {
-        let mut c = Command::new("bash");
-        c.arg(file).current_dir(&dir).envs(env);
-        if let Some(t) = task {
-            c.env("SLURM_ARRAY_TASK_ID", t);
-        }
-        let out = c.output().unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8(out.stdout).unwrap()
-    };
-    for task in ["3", "1", "4", "2"] {
-        bash(script("shards.sbatch"), Some(task));
-    }
-    let merged = bash(script("merge.sbatch"), None);
-    let single = ok(&[
-        "flat",
+fn a_line_camera_spreads_over_every_shard() {
+    // One row of 40 pixels over 7 shards: split by rows, six shards held
+    // nothing and one did all the work; split by pixels each holds 5 or 6.
+    let scene = repo("scenes/camera_line.toml");
+    let dir = scratch("line");
+    let base = [
+        "render",
         "--scene",
         &scene,
         "--method",
-        "rendering",
-        "--paths",
-        "250000",
+        "expectation",
+        "--spp",
+        "32",
         "--seed",
-        "8",
-        "--json",
-    ]);
-    assert_eq!(without_seconds(&merged), without_seconds(&single));
+        "9",
+    ];
+    let files = shards(&base, 7, &dir);
+    let mut pixels = 0;
+    for f in &files {
+        let state = State::read(Path::new(f)).unwrap();
+        let held = state.paths / 32;
+        assert!((5..=6).contains(&held), "{f}: {held} pixels");
+        pixels += held;
+    }
+    assert_eq!(pixels, 40);
+    let (single_dir, merged_dir) = (dir.join("single"), dir.join("merged"));
+    let mut single = base.to_vec();
+    single.extend(["--out", single_dir.to_str().unwrap()]);
+    let a = ok(&single);
+    let mut args = vec!["merge", "--out", merged_dir.to_str().unwrap()];
+    args.extend(files.iter().map(String::as_str));
+    assert_eq!(without_seconds(&a), without_seconds(&ok(&args)));
+    for name in ["I.npy", "I_stderr.npy", "d_tx.npy", "d_rot_stderr.npy"] {
+        assert_eq!(
+            std::fs::read(single_dir.join(name)).unwrap(),
+            std::fs::read(merged_dir.join(name)).unwrap(),
+            "{name}"
+        );
+    }
+    // The help says what a rendering's shard is.
+    let help = ok(&["render", "--help"]);
+    assert!(help.contains("pixels") && !help.contains("65536"), "{help}");
 }

@@ -343,7 +343,8 @@ def render(
         ``"images"``: ``{"I": {"mean": array, "stderr": array}, param: {…},
         …}``, float64 arrays of shape (height, width), row 0 at the top (the
         command line's ``I.npy``, ``I_stderr.npy``, ``d_<param>.npy``, …);
-        or, with ``shard`` (a share of the rows), the shard's state.
+        or, with ``shard`` (a share of the pixels, row by row from the top:
+        a single row splits too), the shard's state.
 
     Raises:
         ValueError: bad input, with the command line's message.

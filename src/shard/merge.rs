@@ -21,7 +21,7 @@ pub enum Merged {
 /// Errors, naming the states at fault, unless they are of this format and
 /// version, of one run (same method, hash, seed, paths, number of shards,
 /// header, caveats and quantities), every shard present exactly once, each
-/// holding exactly its blocks or rows.
+/// holding exactly its blocks or pixels.
 pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
     let Some((first_label, first)) = labelled.first() else {
         return Err(Error::Merge("nothing to merge: no state given".into()));
@@ -160,7 +160,7 @@ fn same_header(a: &Header, b: &Header) -> bool {
     }
 }
 
-/// `None` if state `s` holds exactly its shard's blocks or rows (with one
+/// `None` if state `s` holds exactly its shard's blocks or pixels (with one
 /// accumulator per quantity, the paths they count, and the image size of
 /// `first`); else what it should hold, for the message.
 fn misplaced(s: &State, first: &State) -> Option<String> {
@@ -188,21 +188,21 @@ fn misplaced(s: &State, first: &State) -> Option<String> {
                 ..
             },
         ) => {
-            let want = shard.blocks(u64::from(*height));
-            let rows = want.end - want.start;
+            let want = shard.blocks(u64::from(*width) * u64::from(*height));
+            let count = want.end - want.start;
             let ok = (width, height) == (w0, h0)
                 && u64::from(*at) == want.start
-                && pixels.len() as u64 == rows * u64::from(*width)
+                && pixels.len() as u64 == count
                 && pixels.iter().all(|p| p.len() == nq)
-                && s.paths == s.run.paths * rows * u64::from(*width);
-            (!ok).then(|| format!("rows {}..{} of a {w0}×{h0} image", want.start, want.end))
+                && s.paths == s.run.paths * count;
+            (!ok).then(|| format!("pixels {}..{} of a {w0}×{h0} image", want.start, want.end))
         }
-        (Payload::Rows { .. }, Payload::Blocks { .. }) => Some("blocks, not rows".into()),
+        (Payload::Rows { .. }, Payload::Blocks { .. }) => Some("blocks, not pixels".into()),
     }
 }
 
 /// Which fields of two run identities differ, for a message.
-fn differences(a: &RunId, b: &RunId) -> String {
+pub(super) fn differences(a: &RunId, b: &RunId) -> String {
     let mut d = Vec::new();
     if a.method != b.method {
         d.push(format!("method {} against {}", a.method, b.method));

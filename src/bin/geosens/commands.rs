@@ -101,6 +101,12 @@ pub(super) fn merge_command(
     for path in &args.states {
         states.push((path.display().to_string(), State::read(path)?));
     }
+    if args.missing {
+        return super::survey::missing_command(&states, args.shards, out);
+    }
+    if let Some(n) = args.shards {
+        geosens::shard::survey(&states, Some(n))?;
+    }
     match geosens::shard::merge(&states)? {
         Merged::Probe(report) => {
             if args.out.is_some() {

@@ -15,7 +15,8 @@
 //! - every estimation command above takes `--shard I/N --state FILE` (run
 //!   only shard `I` of `N` and write its exact accumulator state), and
 //!   `geosens merge FILE… [--json] [--out DIR]` prints (or writes) what the
-//!   single run would have, bit for bit;
+//!   single run would have, bit for bit (`--missing` lists the shards no
+//!   FILE holds instead, for a rerun);
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
 //!   and thick rods at a few probes and prints them beside the exact solution,
 //!   then every method on two 3D occluder scenes beside their closed forms,
@@ -84,7 +85,7 @@ struct ShardArgs {
 #[derive(Debug, Args)]
 struct MergeArgs {
     /// The state files, one per shard, in any order.
-    #[arg(required = true, value_name = "FILE")]
+    #[arg(required_unless_present = "missing", value_name = "FILE")]
     states: Vec<std::path::PathBuf>,
     /// Print one JSON line instead of a table (a rendering's merge prints
     /// its JSON line whatever).
@@ -93,6 +94,16 @@ struct MergeArgs {
     /// Folder a rendering's images go to (its states only).
     #[arg(long)]
     out: Option<std::path::PathBuf>,
+    /// Merge nothing: print the shards that no FILE holds, as a Slurm array
+    /// (`2,5-7`; nothing when none is), and on stderr how far the run has
+    /// got. The states must be of one run (of N shards, with `--shards N`).
+    #[arg(long, conflicts_with_all = ["json", "out"])]
+    missing: bool,
+    /// The run's number of shards: states of a run of another number are
+    /// refused (a folder holding another run's states). With `--missing`
+    /// and no FILE, every shard is missing.
+    #[arg(long, value_name = "N")]
+    shards: Option<u64>,
 }
 
 /// `geosens flat` and `geosens mesh`: a scene file, a method, a run.
@@ -260,6 +271,7 @@ fn exact_result(rod: &Rod, probe: &Probe) -> Result<RunResult, Error> {
 mod commands;
 mod output;
 mod render;
+mod survey;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();

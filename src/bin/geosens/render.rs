@@ -38,9 +38,27 @@ pub(super) struct RenderArgs {
     /// Worker threads, 0 = all cores (images do not depend on it).
     #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     threads: usize,
-    /// Sharding (by rows of the image).
+    /// Sharding (by pixels of the image).
     #[command(flatten)]
-    shard: ShardArgs,
+    shard: RenderShardArgs,
+}
+
+/// `--shard I/N --state FILE` of `geosens render`: [`ShardArgs`] with the
+/// help of a rendering's shards.
+#[derive(Debug, Args)]
+pub(super) struct RenderShardArgs {
+    /// Render only shard I of N of the image (1 ≤ I ≤ N): the image's
+    /// pixels, row by row from the top, split into N contiguous shares of
+    /// nearly equal counts (so a single row splits too; past one shard per
+    /// pixel the others are empty), each with all `--spp` paths of its
+    /// pixels; needs `--state`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<Shard>,
+    /// Write the shard's exact state (its pixels' sums) to FILE (JSON)
+    /// instead of images; `geosens merge --out DIR` writes the images from
+    /// all states. Without `--shard`, the whole image is one shard (1/1).
+    #[arg(long, value_name = "FILE")]
+    state: Option<PathBuf>,
 }
 
 /// A parameter name as a file name: letters, digits, `-` and `_` kept,
