@@ -335,15 +335,11 @@ impl State {
 
     /// Writes the state to `path` as one line of JSON, through a temporary
     /// file beside it (`FILE.part`, renamed when complete), so that a shard
-    /// killed while writing leaves no file that looks whole.
+    /// killed while writing leaves no file that looks whole; a write that
+    /// fails (a full disk) removes the temporary and leaves a state already
+    /// at `path` as it was.
     pub fn write(&self, path: &std::path::Path) -> Result<(), Error> {
-        let cannot =
-            |e: std::io::Error| Error::Output(format!("cannot write {}: {e}", path.display()));
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".part");
-        let tmp = std::path::PathBuf::from(tmp);
-        std::fs::write(&tmp, self.to_json()? + "\n").map_err(cannot)?;
-        std::fs::rename(&tmp, path).map_err(cannot)
+        crate::file_set::write_whole(path, (self.to_json()? + "\n").as_bytes())
     }
 
     /// Reads the state `text` named `name` in messages (its file), with
