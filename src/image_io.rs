@@ -7,16 +7,21 @@
 //! exact `f64` for NumPy) or as a picture ([`write_png_magnitude`] for
 //! values ≥ 0 such as `I` and standard errors; [`write_png_diverging`] for
 //! signed sensitivities). [`robust_scale`] picks a display range that a few
-//! outlier pixels cannot flatten, and [`scale_tag`] spells it for a file
-//! name, as in `d_occ_tx_pm1.23e-2.png`.
+//! outlier pixels cannot flatten; a PNG holds it in its text (`Scale`, and
+//! a `Description` of the map with [`scale_tag`]'s short form), so that its
+//! name need not change with it.
 //!
-//! Every writer checks the plane first and names the file in its errors
+//! Each `write_*` writes one file whole or not at all (through a temporary
+//! renamed when complete); each `add_*` writes one file of a
+//! [`FileSet`], whose files are renamed into place together. Every writer
+//! checks the plane first and names the file in its errors
 //! ([`Error::Output`]); none panics on bad input.
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 use crate::error::Error;
+use crate::file_set::{FileSet, io_error, output_error};
 
 /// A row-major image of f64 values, row 0 at the top.
 #[derive(Debug, Clone, Copy)]
@@ -33,11 +38,23 @@ pub struct Plane<'a> {
 /// neither viridis nor red–blue contains.
 pub const NON_FINITE_RGB: [u8; 3] = [255, 0, 255];
 
-/// Writes `plane` as OpenEXR: one channel `Y` of 32-bit floats, ZIP
-/// compressed (lossless), row 0 at the top. Values are converted with `as
-/// f32` (rounded to nearest; beyond the f32 range they become ±∞); NaN and
-/// ±∞ are written as they are.
+/// The file `add` writes, as a set of one.
+fn whole(add: impl FnOnce(&mut FileSet) -> Result<(), Error>) -> Result<(), Error> {
+    let mut set = FileSet::new();
+    add(&mut set)?;
+    set.commit().map(drop)
+}
+
+/// Writes `plane` as OpenEXR ([`add_exr`]), whole or not at all.
 pub fn write_exr(path: &Path, plane: &Plane) -> Result<(), Error> {
+    whole(|set| add_exr(set, path, plane))
+}
+
+/// Writes `plane` as OpenEXR into `set`: one channel `Y` of 32-bit floats,
+/// ZIP compressed (lossless), row 0 at the top. Values are converted with
+/// `as f32` (rounded to nearest; beyond the f32 range they become ±∞); NaN
+/// and ±∞ are written as they are.
+pub fn add_exr(set: &mut FileSet, path: &Path, plane: &Plane) -> Result<(), Error> {
     use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer};
     use exr::prelude::{LayerAttributes, WritableImage};
     check(path, plane)?;
@@ -49,16 +66,21 @@ pub fn write_exr(path: &Path, plane: &Plane) -> Result<(), Error> {
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(vec![channel].into()),
     );
-    let mut out = create(path)?;
-    let written = Image::from_layer(layer).write().to_buffered(&mut out);
-    written.map_err(|e| match e {
-        exr::error::Error::Io(e) => io_error(path, &e),
-        e => output_error(path, e),
-    })?;
-    flush(path, out)
+    set.write(path, |out| {
+        let written = Image::from_layer(layer).write().to_buffered(out);
+        written.map_err(|e| match e {
+            exr::error::Error::Io(e) => io_error(path, &e),
+            e => output_error(path, e),
+        })
+    })
 }
 
-/// Writes `plane` as a NumPy `.npy` file (format version 1.0): dtype `'<f8'`
+/// Writes `plane` as a NumPy `.npy` file ([`add_npy`]), whole or not at all.
+pub fn write_npy(path: &Path, plane: &Plane) -> Result<(), Error> {
+    whole(|set| add_npy(set, path, plane))
+}
+
+/// Writes `plane` into `set` as a NumPy `.npy` file (format version 1.0): dtype `'<f8'`
 /// (little-endian f64), shape `(height, width)`, C order, every value bit for
 /// bit, NaN and ±∞ included. `numpy.load(path)` reads it back.
 ///
@@ -67,7 +89,7 @@ pub fn write_exr(path: &Path, plane: &Plane) -> Result<(), Error> {
 /// `npyz` (whose reader parses any header) brings `py_literal`, `pest`,
 /// `pest_derive`, `num-bigint` and `psm`'s assembly build script, some twenty
 /// crates, to write one fixed header.
-pub fn write_npy(path: &Path, plane: &Plane) -> Result<(), Error> {
+pub fn add_npy(set: &mut FileSet, path: &Path, plane: &Plane) -> Result<(), Error> {
     check(path, plane)?;
     let dict = format!(
         "{{'descr': '<f8', 'fortran_order': False, 'shape': ({}, {}), }}",
@@ -83,17 +105,23 @@ pub fn write_npy(path: &Path, plane: &Plane) -> Result<(), Error> {
     header.extend_from_slice(dict.as_bytes());
     header.resize(10 + header_len - 1, b' ');
     header.push(b'\n');
-    let mut out = create(path)?;
-    let mut write = || -> io::Result<()> {
-        out.write_all(&header)?;
-        (plane.data.iter()).try_for_each(|x| out.write_all(&x.to_le_bytes()))
-    };
-    write().map_err(|e| io_error(path, &e))?;
-    flush(path, out)
+    set.write(path, |out| {
+        let mut write = || -> io::Result<()> {
+            out.write_all(&header)?;
+            (plane.data.iter()).try_for_each(|x| out.write_all(&x.to_le_bytes()))
+        };
+        write().map_err(|e| io_error(path, &e))
+    })
 }
 
-/// Writes `plane` as an 8-bit RGB PNG in the perceptual map viridis, from
-/// **0** (dark purple, `#440154`) to `max` (yellow, `#fde725`).
+/// Writes `plane` as a PNG ([`add_png_magnitude`]), whole or not at all.
+pub fn write_png_magnitude(path: &Path, plane: &Plane, max: f64) -> Result<(), Error> {
+    whole(|set| add_png_magnitude(set, path, plane, max))
+}
+
+/// Writes `plane` into `set` as an 8-bit RGB PNG in the perceptual map
+/// viridis, from **0** (dark purple, `#440154`) to `max` (yellow,
+/// `#fde725`); its text gives `max` (`Scale`) and the map (`Description`).
 ///
 /// The low end is 0, not the image's minimum, so that the images of one
 /// render (`I` and its standard error) read alike and a colour means the same
@@ -101,14 +129,37 @@ pub fn write_npy(path: &Path, plane: &Plane) -> Result<(), Error> {
 /// to the low end, values above `max` to the high end. NaN and ±∞ are
 /// [magenta](NON_FINITE_RGB). A `max` ≤ 0 or not finite is "no range": every
 /// finite pixel takes the low colour.
-pub fn write_png_magnitude(path: &Path, plane: &Plane, max: f64) -> Result<(), Error> {
-    write_png(path, plane, magnitude_map(max))
+pub fn add_png_magnitude(
+    set: &mut FileSet,
+    path: &Path,
+    plane: &Plane,
+    max: f64,
+) -> Result<(), Error> {
+    let legend = if ranged(max) {
+        format!(
+            "viridis from 0 (#440154) to {} (#fde725), clamped; magenta: not finite",
+            scale_tag(max)
+        )
+    } else {
+        NO_RANGE.to_owned()
+    };
+    add_png(set, path, plane, magnitude_map(max), (max, &legend))
 }
+
+/// Whether a PNG's scale spans a range (else every finite pixel takes one
+/// colour).
+fn ranged(scale: f64) -> bool {
+    scale.is_finite() && scale > 0.0
+}
+
+/// A PNG's description when its scale spans no range.
+const NO_RANGE: &str =
+    "no range (a scale of 0, negative or not finite): one colour; magenta: not finite";
 
 /// The colour of a finite value in [`write_png_magnitude`]'s map (viridis
 /// from 0 to `max`), for drawing such images elsewhere (the book's figures).
 pub fn magnitude_map(max: f64) -> impl Fn(f64) -> [u8; 3] {
-    let ranged = max.is_finite() && max > 0.0;
+    let ranged = ranged(max);
     move |x| {
         let t = if ranged { x / max } else { 0.0 };
         let c = colorous::VIRIDIS.eval_continuous(t.clamp(0.0, 1.0));
@@ -116,8 +167,14 @@ pub fn magnitude_map(max: f64) -> impl Fn(f64) -> [u8; 3] {
     }
 }
 
-/// Writes `plane` as an 8-bit RGB PNG in the diverging map red–blue
-/// (ColorBrewer RdBu reversed): `+scale` and above are dark red (`#67001f`),
+/// Writes `plane` as a PNG ([`add_png_diverging`]), whole or not at all.
+pub fn write_png_diverging(path: &Path, plane: &Plane, scale: f64) -> Result<(), Error> {
+    whole(|set| add_png_diverging(set, path, plane, scale))
+}
+
+/// Writes `plane` into `set` as an 8-bit RGB PNG in the diverging map
+/// red–blue (ColorBrewer RdBu reversed; its text gives `scale` and the
+/// map): `+scale` and above are dark red (`#67001f`),
 /// `-scale` and below dark blue (`#053061`), 0 the neutral near-white middle
 /// (`#f7f7f7`). Colours are interpolated linearly between the map's 11 stops,
 /// as matplotlib's `RdBu_r` does (colorous's own continuous evaluation is a
@@ -125,14 +182,28 @@ pub fn magnitude_map(max: f64) -> impl Fn(f64) -> [u8; 3] {
 ///
 /// NaN and ±∞ are [magenta](NON_FINITE_RGB). A `scale` ≤ 0 or not finite is
 /// "no range": every finite pixel takes the middle colour.
-pub fn write_png_diverging(path: &Path, plane: &Plane, scale: f64) -> Result<(), Error> {
-    write_png(path, plane, diverging_map(scale))
+pub fn add_png_diverging(
+    set: &mut FileSet,
+    path: &Path,
+    plane: &Plane,
+    scale: f64,
+) -> Result<(), Error> {
+    let tag = scale_tag(scale);
+    let legend = if ranged(scale) {
+        format!(
+            "red-blue (RdBu reversed) from -{tag} (#053061) through 0 (#f7f7f7) to +{tag} \
+             (#67001f), clamped; magenta: not finite"
+        )
+    } else {
+        NO_RANGE.to_owned()
+    };
+    add_png(set, path, plane, diverging_map(scale), (scale, &legend))
 }
 
 /// The colour of a finite value in [`write_png_diverging`]'s map (red–blue
 /// over `±scale`), for drawing such images elsewhere (the book's figures).
 pub fn diverging_map(scale: f64) -> impl Fn(f64) -> [u8; 3] {
-    let ranged = scale.is_finite() && scale > 0.0;
+    let ranged = ranged(scale);
     // Stop k of 0..=10 runs from blue (k = 0, negative) to red (k = 10).
     let stops: Vec<[f64; 3]> = (0..11)
         .map(|k| colorous::RED_BLUE.eval_rational(10 - k, 11))
@@ -171,7 +242,7 @@ pub fn robust_scale(data: &[f64]) -> f64 {
     }
 }
 
-/// A short, file-name-safe rendering of a scale with three significant
+/// A short rendering of a scale (a PNG's description) with three significant
 /// digits and no trailing zeros: `0.0123` → `"1.23e-2"`, `1.0` → `"1e0"`,
 /// `250.0` → `"2.5e2"`; `0` → `"0"`, a negative value keeps its `-`, NaN →
 /// `"nan"`, ±∞ → `"inf"`/`"-inf"`. Only digits, `.`, `-`, `e` and those
@@ -206,8 +277,15 @@ fn check(path: &Path, plane: &Plane) -> Result<(), Error> {
     Err(output_error(path, cause))
 }
 
-/// Checks `plane`, maps every value to a colour and writes the PNG.
-fn write_png(path: &Path, plane: &Plane, colour: impl Fn(f64) -> [u8; 3]) -> Result<(), Error> {
+/// Checks `plane`, maps every value to a colour and writes the PNG into
+/// `set`, with its scale and the map's description (`legend`) as text.
+fn add_png(
+    set: &mut FileSet,
+    path: &Path,
+    plane: &Plane,
+    colour: impl Fn(f64) -> [u8; 3],
+    (scale, legend): (f64, &str),
+) -> Result<(), Error> {
     check(path, plane)?;
     let size = |n: usize, what: &str| {
         u32::try_from(n).map_err(|_| output_error(path, format!("{what} {n} is too large for PNG")))
@@ -221,46 +299,25 @@ fn write_png(path: &Path, plane: &Plane, colour: impl Fn(f64) -> [u8; 3]) -> Res
         }
     };
     let rgb: Vec<u8> = plane.data.iter().flat_map(|&x| pixel(x)).collect();
-    let mut out = create(path)?;
-    let mut encoder = png::Encoder::new(&mut out, w, h);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
     let png_error = |e: png::EncodingError| match e {
         png::EncodingError::IoError(e) => io_error(path, &e),
         e => output_error(path, e),
     };
-    let mut writer = encoder.write_header().map_err(png_error)?;
-    writer.write_image_data(&rgb).map_err(png_error)?;
-    writer.finish().map_err(png_error)?;
-    flush(path, out)
-}
-
-/// Creates (or truncates) the file at `path`.
-fn create(path: &Path) -> Result<BufWriter<File>, Error> {
-    File::create(path)
-        .map(BufWriter::new)
-        .map_err(|e| io_error(path, &e))
-}
-
-/// Flushes the buffer, so that a failed last write is reported, not dropped.
-fn flush(path: &Path, mut out: BufWriter<File>) -> Result<(), Error> {
-    out.flush().map_err(|e| io_error(path, &e))
-}
-
-/// An I/O failure on `path`, saying which directory is missing if one is.
-fn io_error(path: &Path, e: &io::Error) -> Error {
-    let dir = path.parent().filter(|dir| !dir.as_os_str().is_empty());
-    match dir {
-        Some(dir) if e.kind() == io::ErrorKind::NotFound && !dir.is_dir() => {
-            output_error(path, format!("directory {} does not exist", dir.display()))
-        }
-        _ => output_error(path, e),
-    }
-}
-
-/// `cannot write <path>: <cause>`.
-fn output_error(path: &Path, cause: impl std::fmt::Display) -> Error {
-    Error::Output(format!("cannot write {}: {cause}", path.display()))
+    set.write(path, |out: &mut BufWriter<File>| {
+        let mut encoder = png::Encoder::new(out, w, h);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        // The scale at full precision (it round-trips), ASCII as tEXt wants.
+        encoder
+            .add_text_chunk("Scale".into(), format!("{scale:e}"))
+            .map_err(png_error)?;
+        encoder
+            .add_text_chunk("Description".into(), legend.into())
+            .map_err(png_error)?;
+        let mut writer = encoder.write_header().map_err(png_error)?;
+        writer.write_image_data(&rgb).map_err(png_error)?;
+        writer.finish().map_err(png_error)
+    })
 }
 
 #[cfg(test)]

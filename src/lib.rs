@@ -53,6 +53,7 @@ pub mod estimator;
 pub mod fd;
 #[cfg(feature = "figures")]
 mod figures_common;
+pub mod file_set;
 pub mod flat;
 pub mod image;
 pub mod image_io;

@@ -11,7 +11,9 @@
 //! `fd` and the rod or the scene in full, meshes inline), this shard's index
 //! and blocks, what the printing needs ([`Header`], caveats), and per block
 //! and quantity the moments, every float as its IEEE-754 bits (JSON numbers
-//! would lose NaN and infinity, which an overflowed run must keep).
+//! would lose NaN and infinity, which an overflowed run must keep), and a
+//! SHA-256 of all that ([`State::data_checksum`]), which the reader checks:
+//! a bit flipped in a file is an error, not another result.
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::flat::file::read_bytes_capped;
@@ -27,8 +29,9 @@ use std::fmt;
 use std::ops::Range;
 use std::str::FromStr;
 
-/// The format tag of a state file; a reader refuses any other.
-pub const STATE_FORMAT: &str = "geosens-state/1";
+/// The format tag of a state file; a reader refuses any other (`/1`
+/// states carried no checksum).
+pub const STATE_FORMAT: &str = "geosens-state/2";
 
 /// Largest state file [`State::read`] reads (bytes): 4 GiB, some 25
 /// million blocks × quantities at about 170 bytes each (a state of
@@ -221,6 +224,8 @@ pub struct State {
     pub paths: u64,
     /// Wall time of this shard's sampling, in seconds.
     pub seconds: f64,
+    /// [`State::data_checksum`] when the shard wrote it.
+    pub checksum: String,
 }
 
 impl State {
@@ -229,8 +234,8 @@ impl State {
         serde_json::to_string(self).map_err(|e| Error::Output(e.to_string()))
     }
 
-    /// Reads a state from JSON; errors if it is not one or of another
-    /// format.
+    /// Reads a state from JSON; errors if it is not one, of another
+    /// format, or its data do not match its checksum.
     pub fn from_json(text: &str) -> Result<State, Error> {
         // A cut or damaged file says so, not "no format".
         let value = serde_json::from_str::<serde_json::Value>(text.trim_start_matches('\u{feff}'))
@@ -245,16 +250,63 @@ impl State {
         match format.as_deref() {
             Some(STATE_FORMAT) => {}
             Some(other) => {
+                let why = if other == "geosens-state/1" {
+                    " (written by an earlier geosens, without a checksum: run the shard again)"
+                } else {
+                    ""
+                };
                 return Err(Error::Merge(format!(
-                    "a state of format {other:?}, expected {STATE_FORMAT:?}"
+                    "a state of format {other:?}, expected {STATE_FORMAT:?}{why}"
                 )));
             }
             None => return Err(Error::Merge("not a geosens state (no \"format\")".into())),
         }
         let state: State = serde_json::from_value(value)
             .map_err(|e| Error::Merge(format!("a malformed state: {e}")))?;
+        if state.checksum != state.data_checksum()? {
+            return Err(Error::Merge(
+                "a damaged state: its data do not match its checksum (a bit changed or a \
+                 field edited since its shard wrote it): run that shard again"
+                    .into(),
+            ));
+        }
         state.check()?;
         Ok(state)
+    }
+
+    /// The SHA-256 (hex) of the state's data: the compact JSON of every
+    /// field but `seconds` and `checksum`. A state read back writes the
+    /// same JSON (floats round-trip exactly), so this sums the data, not
+    /// the file's layout; the wall time, which differs between two
+    /// identical runs, is left out so that they carry the same checksum.
+    pub fn data_checksum(&self) -> Result<String, Error> {
+        // Destructured without `..`: a field added to `State` must be
+        // placed here, in the sum or out of it, or this does not compile.
+        let State {
+            format,
+            version,
+            run,
+            shard,
+            header,
+            caveats,
+            quantities,
+            payload,
+            paths,
+            seconds: _,
+            checksum: _,
+        } = self;
+        let data = (
+            format, version, run, shard, header, caveats, quantities, payload, paths,
+        );
+        let mut sum = HashWriter(Sha256::new());
+        serde_json::to_writer(&mut sum, &data).map_err(|e| Error::Output(e.to_string()))?;
+        Ok(hex(&sum.0.finalize()))
+    }
+
+    /// The state with its checksum set to its data's.
+    fn sealed(mut self) -> Result<State, Error> {
+        self.checksum = self.data_checksum()?;
+        Ok(self)
     }
 
     /// Refuses a state that contradicts itself (an edited or damaged file
@@ -284,15 +336,11 @@ impl State {
 
     /// Writes the state to `path` as one line of JSON, through a temporary
     /// file beside it (`FILE.part`, renamed when complete), so that a shard
-    /// killed while writing leaves no file that looks whole.
+    /// killed while writing leaves no file that looks whole; a write that
+    /// fails (a full disk) removes the temporary and leaves a state already
+    /// at `path` as it was.
     pub fn write(&self, path: &std::path::Path) -> Result<(), Error> {
-        let cannot =
-            |e: std::io::Error| Error::Output(format!("cannot write {}: {e}", path.display()));
-        let mut tmp = path.as_os_str().to_owned();
-        tmp.push(".part");
-        let tmp = std::path::PathBuf::from(tmp);
-        std::fs::write(&tmp, self.to_json()? + "\n").map_err(cannot)?;
-        std::fs::rename(&tmp, path).map_err(cannot)
+        crate::file_set::write_whole(path, (self.to_json()? + "\n").as_bytes())
     }
 
     /// Reads the state `text` named `name` in messages (its file), with
@@ -350,7 +398,7 @@ impl Job {
         let total = runner::blocks(cfg.paths);
         let range = shard.blocks(total);
         let (moments, seconds) = runner::sample_blocks(est.as_ref(), cfg, range.clone(), progress)?;
-        Ok(State {
+        State {
             format: STATE_FORMAT.to_owned(),
             version: env!("CARGO_PKG_VERSION").to_owned(),
             run: RunId {
@@ -373,7 +421,9 @@ impl Job {
             },
             paths: paths_in(&range, cfg.paths),
             seconds,
-        })
+            checksum: String::new(),
+        }
+        .sealed()
     }
 }
 
@@ -397,7 +447,7 @@ impl RenderJob {
         let range = shard.blocks(u64::from(width) * u64::from(height));
         let (pixels, seconds) =
             render_pixels(est.as_ref(), spp, seed, threads, range.clone(), progress)?;
-        Ok(State {
+        State {
             format: STATE_FORMAT.to_owned(),
             version: env!("CARGO_PKG_VERSION").to_owned(),
             run: RunId {
@@ -427,16 +477,35 @@ impl RenderJob {
             },
             paths: spp * (range.end - range.start),
             seconds,
-        })
+            checksum: String::new(),
+        }
+        .sealed()
     }
 }
 
 /// The SHA-256 of `text`, in hex.
 fn sha256(text: &str) -> String {
-    Sha256::digest(text.as_bytes())
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
+    hex(&Sha256::digest(text.as_bytes()))
+}
+
+/// `bytes` in lower-case hex.
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// A SHA-256 fed by a writer: a state's data are summed as they are
+/// serialised, never held as one more copy of the text.
+struct HashWriter(Sha256);
+
+impl std::io::Write for HashWriter {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0.update(buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 mod merge;

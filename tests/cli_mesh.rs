@@ -1,6 +1,7 @@
 //! `geosens mesh`: the JSON line of `flat` with the gradient axes x, y, z,
 //! agreement of every method with the closed form on the shipped occluder
-//! scene, reproducibility whatever the thread count, and clear errors.
+//! scene, reproducibility whatever the thread count, clear errors, and the
+//! same result from files with a byte-order mark or CRLF line ends.
 use geosens::mesh::exact::{occluded_irradiance_with_gradient, sensitivity};
 use geosens::mesh::file;
 use serde_json::Value;
@@ -167,5 +168,49 @@ fn bad_input_is_a_clear_error() {
         "1e-4",
     ]);
     assert_eq!(out.status.code(), Some(1));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A UTF-8 byte-order mark (as some editors write) or Windows line ends in
+/// the scene file or in its OBJ mesh change nothing: the same scene loads
+/// and the run prints the same numbers. A mark before an OBJ's first `v`
+/// used to hide that vertex, shifting every face index by one.
+#[test]
+fn a_byte_order_mark_or_crlf_line_ends_change_nothing() {
+    let dir = std::env::temp_dir().join(format!("geosens-cli-mesh-bom-{}", std::process::id()));
+    let toml = std::fs::read_to_string(scene("occluder.toml")).unwrap();
+    let obj = std::fs::read_to_string(scene("occluder.obj")).unwrap();
+    // The mesh starts with its first vertex (no comment, no object name),
+    // so that a mark would stick to that `v`.
+    // A fifth vertex, unused, lets a lost first one go unnoticed (the face
+    // `f 1 2 3 4` then reads vertices 2 to 5, still a square's worth).
+    let obj = format!("{}v -0.05 0.0 1.0\n", &obj[obj.find("\nv ").unwrap() + 1..]);
+    let json = file::to_json(&file::load(&scene("occluder.toml")).unwrap()).unwrap();
+    let bom = |s: &str| format!("\u{feff}{s}");
+    let crlf = |s: &str| s.replace('\n', "\r\n");
+    let run = |name: &str, scene_text: String, ext: &str, obj_text: String| {
+        let d = dir.join(name);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join("occluder.obj"), obj_text).unwrap();
+        let path = d.join(format!("scene.{ext}"));
+        std::fs::write(&path, scene_text).unwrap();
+        let loaded = file::MeshFile::of(&file::load(&path).unwrap());
+        let mut v = mesh_json(&path, "rendering", &["--paths", "4000", "--seed", "3"]);
+        v["seconds"] = Value::Null;
+        (loaded, v)
+    };
+    let plain = run("plain", toml.clone(), "toml", obj.clone());
+    for (name, scene_text, ext, obj_text) in [
+        ("obj_bom", toml.clone(), "toml", bom(&obj)),
+        ("obj_crlf", toml.clone(), "toml", crlf(&obj)),
+        ("obj_bom_crlf", toml.clone(), "toml", bom(&crlf(&obj))),
+        ("toml_bom_crlf", bom(&crlf(&toml)), "toml", obj.clone()),
+        ("json", json.clone(), "json", obj.clone()),
+        ("json_bom_crlf", bom(&crlf(&json)), "json", bom(&obj)),
+    ] {
+        let other = run(name, scene_text, ext, obj_text);
+        assert_eq!(other.0, plain.0, "{name}: a different scene");
+        assert_eq!(other.1, plain.1, "{name}: a different result");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

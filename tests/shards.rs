@@ -326,13 +326,16 @@ fn states_that_are_not_one_whole_run_are_refused() {
         err.contains("method expectation against intensity"),
         "{err}"
     );
-    // The state file `from` with `edit` applied, written as `name`.
+    // The state file `from` with `edit` applied and its checksum made
+    // right again (a writer's own slip, which the checksum cannot see),
+    // written as `name`.
     let edited = |from: &str, name: &str, edit: &dyn Fn(&mut Value)| {
-        let mut v: Value = serde_json::from_str(&std::fs::read_to_string(from).unwrap()).unwrap();
-        edit(&mut v);
-        let path = dir.join(name);
-        std::fs::write(&path, v.to_string()).unwrap();
-        path.to_str().unwrap().to_owned()
+        let path = edited_state(from, &dir.join(name), edit);
+        let mut state: State =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        state.checksum = state.data_checksum().unwrap();
+        std::fs::write(&path, state.to_json().unwrap()).unwrap();
+        path
     };
     // A damaged state: a block dropped.
     let damaged = edited(s2, "damaged.json", &|v| {
@@ -382,6 +385,15 @@ fn states_that_are_not_one_whole_run_are_refused() {
     );
     let err = refused(&["merge", dir.join("absent.json").to_str().unwrap()]);
     assert!(err.contains("cannot read"), "{err}");
+}
+
+/// The state file `from` with `edit` applied, written to `to` (checksum
+/// untouched); returns `to`.
+fn edited_state(from: &str, to: &Path, edit: &dyn Fn(&mut Value)) -> String {
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(from).unwrap()).unwrap();
+    edit(&mut v);
+    std::fs::write(to, v.to_string()).unwrap();
+    to.to_str().unwrap().to_owned()
 }
 
 #[test]

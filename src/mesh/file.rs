@@ -220,8 +220,14 @@ fn read_obj(path: &Path, name: &str) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), Erro
             path.display()
         ))
     };
-    let bytes =
+    let mut bytes =
         read_bytes_capped(path, MAX_SCENE_BYTES, None).map_err(|why| fail(why.to_string()))?;
+    // A UTF-8 byte-order mark, as some editors write: tobj would read it as
+    // part of the first line's keyword and drop that line (a first vertex
+    // lost shifts every face index by one).
+    if bytes.starts_with(b"\xef\xbb\xbf") {
+        bytes.drain(..3);
+    }
     let options = tobj::LoadOptions {
         triangulate: true,
         ignore_points: true,

@@ -3,7 +3,7 @@
 //! rendering's images or the comparison's figures lost after minutes or
 //! hours, a cluster job with them).
 use geosens::Error;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Creates `dir` if missing and proves it writable with a file made and
 /// removed in it.
@@ -13,6 +13,21 @@ pub(super) fn writable_dir(dir: &Path) -> Result<(), Error> {
     let probe = dir.join(format!(".geosens-probe-{}", std::process::id()));
     std::fs::File::create(&probe).map_err(fail)?;
     std::fs::remove_file(&probe).map_err(fail)
+}
+
+/// The folders `create_dir_all(dir)` would make, deepest first.
+pub(super) fn missing_folders(dir: &Path) -> Vec<PathBuf> {
+    dir.ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .map(Path::to_path_buf)
+        .collect()
+}
+
+/// Removes `folders` (deepest first) where empty: those a failed run made.
+pub(super) fn remove_empty(folders: &[PathBuf]) {
+    for folder in folders {
+        let _ = std::fs::remove_dir(folder);
+    }
 }
 
 /// Proves `path` writable as a file: not a folder, and its folder exists and

@@ -2,12 +2,14 @@
 //! every parameter's sensitivity, with their standard-error images; float
 //! images (OpenEXR, `.npy`), PNGs (a perceptual map for `I` and the error
 //! images, a diverging map centred on 0 for each sensitivity, the scale in
-//! the file name), and one JSON line whose means are the images' mean
-//! pixel values.
+//! the PNG's text), and one JSON line whose means are the images' mean
+//! pixel values. The files are written as one set (`file_set`): fixed
+//! names, so a rerun replaces them, and a failure leaves none of its own.
 use super::*;
+use geosens::file_set::FileSet;
 use geosens::image::{ImageResult, render};
 use geosens::image_io::{
-    Plane, robust_scale, scale_tag, write_exr, write_npy, write_png_diverging, write_png_magnitude,
+    Plane, add_exr, add_npy, add_png_diverging, add_png_magnitude, robust_scale,
 };
 use geosens::job::SceneSource;
 use geosens::job::{ImageReport, RenderJob};
@@ -84,12 +86,24 @@ fn image_plane(size: (usize, usize), data: &[f64]) -> Plane<'_> {
     }
 }
 
-/// Writes the images of `result` into `dir`; returns the files written.
+/// Writes the images of `result` into `dir` as one set; returns the files
+/// written. A failure leaves none of them (nor a temporary), and a folder
+/// it made is removed again.
 fn write_images(result: &ImageResult, dir: &Path) -> Result<Vec<PathBuf>, Error> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| Error::Output(format!("cannot create {}: {e}", dir.display())))?;
+    let made = super::output::missing_folders(dir);
+    let written = std::fs::create_dir_all(dir)
+        .map_err(|e| Error::Output(format!("cannot create {}: {e}", dir.display())))
+        .and_then(|()| write_image_set(result, dir));
+    if written.is_err() {
+        super::output::remove_empty(&made);
+    }
+    written
+}
+
+/// The files of [`write_images`], written into the existing folder `dir`.
+fn write_image_set(result: &ImageResult, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     let size = (result.width as usize, result.height as usize);
-    let mut written = Vec::new();
+    let mut set = FileSet::new();
     for (q, img) in &result.images {
         let stem = match q {
             Quantity::Intensity => "I".to_owned(),
@@ -99,30 +113,22 @@ fn write_images(result: &ImageResult, dir: &Path) -> Result<Vec<PathBuf>, Error>
         let mean: Vec<f64> = img.iter().map(|e| e.mean).collect();
         let stderr: Vec<f64> = img.iter().map(|e| e.stderr).collect();
         for (name, data) in [(stem.clone(), &mean), (format!("{stem}_stderr"), &stderr)] {
-            let exr = dir.join(format!("{name}.exr"));
-            write_exr(&exr, &image_plane(size, data))?;
-            let npy = dir.join(format!("{name}.npy"));
-            write_npy(&npy, &image_plane(size, data))?;
-            written.extend([exr, npy]);
+            let plane = image_plane(size, data);
+            add_exr(&mut set, &dir.join(format!("{name}.exr")), &plane)?;
+            add_npy(&mut set, &dir.join(format!("{name}.npy")), &plane)?;
+            // The sensitivity on a diverging map (±scale), I and the error
+            // images on a perceptual one (0 to scale); the scale in the
+            // PNG's text, not its name, so that a rerun replaces it.
+            let png = dir.join(format!("{name}.png"));
+            let scale = robust_scale(data);
+            if name == stem && !matches!(q, Quantity::Intensity) {
+                add_png_diverging(&mut set, &png, &plane, scale)?;
+            } else {
+                add_png_magnitude(&mut set, &png, &plane, scale)?;
+            }
         }
-        // The sensitivity on a diverging map (±scale), I and the error
-        // images on a perceptual one (0 to scale); the scale in the name.
-        let scale = robust_scale(&mean);
-        let main = if matches!(q, Quantity::Intensity) {
-            let path = dir.join(format!("{stem}_max{}.png", scale_tag(scale)));
-            write_png_magnitude(&path, &image_plane(size, &mean), scale)?;
-            path
-        } else {
-            let path = dir.join(format!("{stem}_pm{}.png", scale_tag(scale)));
-            write_png_diverging(&path, &image_plane(size, &mean), scale)?;
-            path
-        };
-        let err_scale = robust_scale(&stderr);
-        let err = dir.join(format!("{stem}_stderr_max{}.png", scale_tag(err_scale)));
-        write_png_magnitude(&err, &image_plane(size, &stderr), err_scale)?;
-        written.extend([main, err]);
     }
-    Ok(written)
+    set.commit()
 }
 
 /// `geosens render`.
@@ -169,6 +175,22 @@ pub(super) fn render_command(
     }
     let dir = args.out.as_deref().ok_or("--out DIR is needed")?;
     let (estimator, _) = job.prepare()?;
+    // The folders made for the images go again if the run fails.
+    let made = super::output::missing_folders(dir);
+    let rendered = render_into(args, estimator.as_ref(), dir, out);
+    if rendered.is_err() {
+        super::output::remove_empty(&made);
+    }
+    rendered
+}
+
+/// Renders `estimator`'s image as `args` says and writes it into `dir`.
+fn render_into(
+    args: &RenderArgs,
+    estimator: &dyn geosens::estimator::Estimator,
+    dir: &Path,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
     super::output::writable_dir(dir)?;
     let pixels = estimator
         .image()
@@ -176,7 +198,7 @@ pub(super) fn render_command(
     let bar =
         super::output::progress_bar(pixels, "pixels", format!("render {}", estimator.method()));
     let result = render(
-        estimator.as_ref(),
+        estimator,
         args.spp,
         args.seed,
         args.threads,
