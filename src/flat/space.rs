@@ -38,7 +38,8 @@ pub struct Plane {
     pub(super) shape_corners: Vec<(u32, u32)>,
     /// Per shape, the parameters that move it.
     pub(super) shape_params: Vec<SlotSet>,
-    /// Per shape, a bound on its chords ([`chord_bound`]).
+    /// Per shape holding a medium, a bound on its chords ([`chord_bound`]);
+    /// 0 for the others (the walk asks only of media).
     chords: Vec<f64>,
     /// The shapes some parameter moves whose corners weigh (> 0).
     pub(super) weighed_shapes: Vec<u32>,
@@ -168,7 +169,7 @@ impl Plane {
         let chords = scene
             .shapes()
             .iter()
-            .map(|s| chord_bound(&s.vertices))
+            .map(|s| s.medium.map_or(0.0, |_| chord_bound(&s.vertices)))
             .collect();
         Plane {
             chords,

@@ -78,7 +78,8 @@ pub struct Space {
     pub(super) sensor_shape_lamps: Vec<OnceLock<([f64; LAMP_EDGES], f64)>>,
     /// Per mesh, the parameters that move it.
     pub(super) shape_params: Vec<SlotSet>,
-    /// Per mesh, a bound on its chords ([`chord_bound`]).
+    /// Per mesh holding a medium, a bound on its chords ([`chord_bound`]);
+    /// 0 for the others (the walk asks only of media).
     chords: Vec<f64>,
     /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
     /// parameter the index of its rule.
@@ -222,7 +223,7 @@ impl Space {
             chords: scene
                 .shapes()
                 .iter()
-                .map(|s| chord_bound(&s.vertices))
+                .map(|s| s.medium.map_or(0.0, |_| chord_bound(&s.vertices)))
                 .collect(),
             caster: TriangleBvh::new(tris.clone()),
             opaque: TriangleBvh::new(opaque_tris),
