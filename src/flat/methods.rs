@@ -20,6 +20,7 @@ use crate::method::Problem;
 use crate::path::deform::Slots;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::intensity::IntensityEstimator;
+use crate::path::nested::Budget;
 use std::sync::Arc;
 
 /// The methods: every [`Method`] runs on a flatland scene
@@ -121,6 +122,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
         scheme,
         names,
         caveats,
+        budget: Budget::default(),
     }
 }
 
