@@ -241,7 +241,7 @@ fn a_wavy_reflector_matches_finite_differences() {
     // A floor of 24 reflecting segments under a lamp, seen from above: every
     // corner between two of its faces, convex or concave, turns under
     // `rendering::SHARED_TURN` and is a jump between two reflector faces
-    // drawn from shared draws (`walk::reflected_jump`), seen from the sensor
+    // drawn from shared draws (`nested::reflected_jump`), seen from the sensor
     // and from the floor itself; moved up and turned.
     use geosens::flat::Motion;
     let floor = (0..=24)
@@ -273,7 +273,7 @@ fn a_reflecting_ridge_between_light_and_shade_matches_finite_differences() {
     // `rendering::SHARED_TURN`) lit from low on the left, seen from above:
     // its left face bright, its right face in its own shade, so its
     // translation's derivative is mostly the jump across the ridge between
-    // two reflector faces (`walk::reflected_jump`), and its rotation's too
+    // two reflector faces (`nested::reflected_jump`), and its rotation's too
     // in part.
     use geosens::flat::Motion;
     let scene = lamp_over_reflector(

@@ -709,7 +709,7 @@ fn a_reflecting_room_matches_finite_differences() {
 /// A folded reflecting sheet whose faces turn 30° at the crease (under
 /// `rendering::SHARED_TURN`), lit from low on one side: one face bright,
 /// the other in its own shade, so the jump across the crease (two
-/// reflector faces, `walk::reflected_jump`'s shared draws) carries most of
+/// reflector faces, `nested::reflected_jump`'s shared draws) carries most of
 /// the translation's derivative; against finite differences.
 #[test]
 fn a_folded_reflector_between_light_and_shade_matches_finite_differences() {

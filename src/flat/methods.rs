@@ -22,6 +22,7 @@ use crate::method::Problem;
 use crate::path::deform::Slots;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::intensity::IntensityEstimator;
+use crate::path::nested::Budget;
 use crate::path::thin_media::chord_bound;
 use std::sync::Arc;
 
@@ -123,6 +124,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Plan
         scheme,
         names,
         caveats,
+        budget: Budget::default(),
     }
 }
 

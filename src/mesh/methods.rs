@@ -26,6 +26,7 @@ use crate::method::{Method, Problem};
 use crate::path::deform::Slots;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::intensity::IntensityEstimator;
+use crate::path::nested::Budget;
 use crate::path::thin_media::chord_bound;
 use std::f64::consts::{PI, TAU};
 use std::sync::Arc;
@@ -116,6 +117,7 @@ pub fn derivative(scene: Arc<Scene>, scheme: Scheme) -> DerivativeEstimator<Spac
         scheme,
         names,
         caveats,
+        budget: Budget::default(),
     }
 }
 

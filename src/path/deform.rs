@@ -10,6 +10,7 @@
 //! `(u + ṫ_b η + t_b η̇ − v)·n = 0`, so
 //! `ṫ_b = (v − u − t_b η̇)·n / (η·n)` (book: "Flatland: one deformation,
 //! three estimators", *the hit point's velocity*), in the plane and in space.
+use super::nested::Scratch;
 use super::rendering::Rendering;
 use super::walk::{Vertex, light_sample, transmittance_by};
 use super::{Boundaries, Geometry, Hit, Vector};
@@ -451,50 +452,6 @@ impl Slots {
             d.slots[j].u = V::axis(j - self.params);
             d.live.insert(j);
         }
-    }
-}
-
-/// Deformation states reused across the paths of a chunk, for nested walks:
-/// taken and given back, so the hot loop allocates nothing per path.
-#[derive(Debug)]
-pub struct Scratch<V: Vector> {
-    free: Vec<Deform<V>>,
-}
-
-impl<V: Vector> Default for Scratch<V> {
-    fn default() -> Self {
-        Scratch { free: Vec::new() }
-    }
-}
-
-impl<V: Vector> Scratch<V> {
-    /// A zeroed state of `n` slots.
-    #[inline]
-    pub fn take(&mut self, n: usize) -> Deform<V> {
-        match self.free.pop() {
-            Some(mut d) if d.len() == n => {
-                d.clear();
-                d
-            }
-            _ => Deform::new(n),
-        }
-    }
-
-    /// A copy of `d` (the state a connection or nested path starts from).
-    #[inline]
-    pub fn take_copy(&mut self, d: &Deform<V>) -> Deform<V> {
-        let mut t = match self.free.pop() {
-            Some(t) if t.len() == d.len() => t,
-            _ => Deform::new(d.len()),
-        };
-        t.copy_from(d);
-        t
-    }
-
-    /// Returns a state for reuse.
-    #[inline]
-    pub fn give(&mut self, d: Deform<V>) {
-        self.free.push(d);
     }
 }
 

@@ -4,8 +4,9 @@
 //! declaration order, then (transport) the sensor position's gradient.
 //! States are reused across the paths of a chunk: the hot loop allocates
 //! nothing per path.
-use super::deform::{Scratch, Slots};
+use super::deform::Slots;
 use super::expectation::Expectation;
+use super::nested::{Budget, Scratch, Work};
 use super::rendering::Rendering;
 use super::transport::Transport;
 use super::walk::{Frame, Hooks, Vertex, walk};
@@ -121,6 +122,8 @@ pub struct DerivativeEstimator<G> {
     pub names: Vec<Quantity>,
     /// Warnings about particular quantities (see [`Estimator::caveats`]).
     pub caveats: Vec<(Quantity, String)>,
+    /// The nested walks' budget per path ([`super::nested`]).
+    pub budget: Budget,
 }
 
 impl<G: Boundaries> DerivativeEstimator<G> {
@@ -135,6 +138,9 @@ impl<G: Boundaries> DerivativeEstimator<G> {
     ) {
         let g = &self.geometry;
         let slots = &self.slots;
+        // Each path spends its own budget: paths stay independent, and a
+        // run's numbers do not depend on how its paths are chunked.
+        scratch.work = Work::new(self.budget);
         let mut d = scratch.take(slots.len());
         slots.start(&mut d);
         let ((i, scale), d) = match self.scheme {
@@ -166,6 +172,16 @@ impl<G: Boundaries> DerivativeEstimator<G> {
             *o = scale * s.derivative();
         }
         scratch.give(d);
+    }
+}
+
+impl<G: Boundaries> DerivativeEstimator<G> {
+    /// [`Estimator::sample`], and the work the path cost: the events of its
+    /// main walk and of its nested walks.
+    pub fn sample_with_work(&self, rng: &mut PathRng, weights: &mut [f64]) -> Work {
+        let mut scratch = Scratch::default();
+        self.path(rng, &mut scratch, weights, PixelSample::default());
+        scratch.work
     }
 }
 

@@ -15,7 +15,8 @@
 //!
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Expectation" and "The warp field".
-use super::deform::{Deform, Scratch, Slots, connect};
+use super::deform::{Deform, Slots, connect};
+use super::nested::Scratch;
 use super::rendering::frame_spins;
 use super::walk::{Hooks, Vertex};
 use super::{Boundaries, Geometry, Hit, Lobe, Vector};
@@ -119,6 +120,11 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     #[inline]
     fn emission(&mut self, contribution: f64) {
         self.d.collect(contribution);
+    }
+    #[inline]
+    fn visit(&mut self, _x: G::V) {
+        // Counted for the path's work (no nested walk here).
+        self.scratch.work.main += 1;
     }
     #[inline]
     fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {

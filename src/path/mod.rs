@@ -27,6 +27,7 @@ pub mod deform;
 pub mod estimator;
 pub mod expectation;
 pub mod intensity;
+pub mod nested;
 pub mod rendering;
 pub mod thin_media;
 pub mod transport;

@@ -18,8 +18,9 @@
 //!
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Rendering" and "Corner jumps".
-use super::deform::{Deform, Scratch, SlotSet, Slots, connect};
-use super::walk::{Frame, Hooks, Leg, Vertex, radiance, reach, reflected_jump, surface_radiance};
+use super::deform::{Deform, SlotSet, Slots, connect};
+use super::nested::{Scratch, Work, radiance, reflected_jump, surface_radiance};
+use super::walk::{Frame, Hooks, Leg, Vertex, reach};
 use super::{
     Boundaries, BoundaryPoint, BoundaryView, Geometry, Hit, Lobe, NO_PRIM, Prim, Side, Surface,
     Vector,
@@ -106,7 +107,8 @@ pub const SHARED_TURN: f64 = std::f64::consts::FRAC_PI_4;
 
 // ANCHOR: leibniz
 /// The Leibniz term of the free-path domain ending at `t_b` on a moving
-/// boundary, for the slots in `rule`: `β κs e^{−κe t_b} L_s(t_b⁻) ṫ_b`.
+/// boundary, for the slots in `rule`: `β κs e^{−κe t_b} L_s(t_b⁻) ṫ_b`
+/// (`L_s` by a nested path, as the path's `work` admits it).
 #[inline]
 pub(super) fn leibniz<G: Geometry>(
     g: &G,
@@ -115,6 +117,7 @@ pub(super) fn leibniz<G: Geometry>(
     rng: &mut PathRng,
     leg: &Leg<G>,
     t_b: f64,
+    work: &mut Work,
 ) {
     let Leg { x, w, medium, beta } = *leg;
     let Some((ks, ke)) = g.coefficients(medium) else {
@@ -127,9 +130,12 @@ pub(super) fn leibniz<G: Geometry>(
     // Just before the boundary, but farther than the caster's hit
     // threshold even for a nested walk that starts a hair in front of it.
     let end = x + w * (t_b - g.nudge(x + w * t_b).min(0.5 * t_b));
+    let Some(weight) = work.admit(rng) else {
+        return;
+    };
     let wi = g.phase_lobe(medium, w).sample(rng);
-    let ls = radiance(g, rng, end, wi, medium, NO_PRIM);
-    let term = beta * ks * (-ke * t_b).exp() * ls;
+    let ls = radiance(g, work, rng, end, wi, medium, NO_PRIM);
+    let term = beta * ks * (-ke * t_b).exp() * ls * weight;
     for j in moving.iter() {
         let s = &mut d.slots[j];
         s.add_boundary(term * s.tb_dot, (term * s.tb_dot).abs());
@@ -147,7 +153,9 @@ const EDGE_ON: f64 = 1e-12;
 /// drawn, the jump of the radiance across it evaluated exactly at it (one
 /// nested path for each side), times its velocity relative to the frame,
 /// for every slot. `spin` must hold the frame's turn rates (see
-/// [`frame_spins`]), `turning` the slots whose frame turns.
+/// [`frame_spins`]), `turning` the slots whose frame turns; the nested
+/// paths as the path's `work` admits them.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn corner_jump<G: Boundaries>(
     g: &G,
@@ -157,6 +165,7 @@ pub(super) fn corner_jump<G: Boundaries>(
     v: &Vertex<G>,
     turning: SlotSet,
     frozen: bool,
+    work: &mut Work,
 ) {
     // A vertex that stays put in a frame that stays put sees only the
     // discontinuities of moving shapes move.
@@ -178,7 +187,7 @@ pub(super) fn corner_jump<G: Boundaries>(
         return;
     }
     g.boundary_points(v, &view, rng, |rng, b| {
-        corner_term(g, slots, d, rng, v, frozen, moving_view, &b)
+        corner_term(g, slots, d, rng, v, frozen, moving_view, &b, work)
     });
 }
 
@@ -194,6 +203,7 @@ fn corner_term<G: Boundaries>(
     frozen: bool,
     moving_view: SlotSet,
     b: &BoundaryPoint<G::V>,
+    work: &mut Work,
 ) {
     let r = b.q - v.x;
     let dist = r.length();
@@ -242,9 +252,9 @@ fn corner_term<G: Boundaries>(
     // 3·10⁻⁵ rad from edge-on lost 13 % of its derivative). The step takes
     // such a face's plane behind the ray's origin down to γ ~ 10⁻⁷.
     let past = b.q + wq * g.nudge(b.q);
-    let side = |rng: &mut PathRng, side: Side| match side {
-        Side::Surface(p) => surface_radiance(g, rng, g.off_boundary(b, p), p, wq, medium),
-        Side::Past => radiance(g, rng, past, wq, medium, NO_PRIM),
+    let side = |work: &mut Work, rng: &mut PathRng, side: Side| match side {
+        Side::Surface(p) => surface_radiance(g, work, rng, g.off_boundary(b, p), p, wq, medium),
+        Side::Past => radiance(g, work, rng, past, wq, medium, NO_PRIM),
     };
     let reflector = |s: Side| match s {
         Side::Surface(p) => matches!(g.surface(p), Surface::Reflector { .. }).then_some(p),
@@ -268,24 +278,37 @@ fn corner_term<G: Boundaries>(
         }
         _ => None,
     };
+    // A side that is a lamp or black is known; a reflector's or the
+    // space past the boundary takes a nested path, as the work admits.
+    let walks = |s: Side| reflector(s).is_some() || s == Side::Past;
+    let weight = if walks(ahead) || walks(behind) {
+        work.admit(rng)
+    } else {
+        Some(1.0)
+    };
+    let Some(weight) = weight else {
+        for j in involved.iter() {
+            d.slots[j].tb_dot = 0.0;
+        }
+        return;
+    };
     // The jump by `n` pairs of nested paths, averaged (one but at a
     // camera pixel: see `Boundaries::jump_paths`).
     let n = g.jump_paths(v).max(1);
     let mut jump = 0.0;
     for _ in 0..n {
         jump += if let Some((a, b)) = shared {
-            reflected_jump(g, rng, a, b, wq, medium)
+            reflected_jump(g, work, rng, a, b, wq, medium)
         } else {
             // Common random numbers for the two sides.
-            let mut twin = rng.clone();
-            let l_ahead = side(rng, ahead);
-            let l_behind = side(&mut twin, behind);
-            l_behind - l_ahead
+            work.jump(rng, |work, rng, far| {
+                side(work, rng, if far { behind } else { ahead })
+            })
         };
     }
     let jump = jump / n as f64;
     // d/dπ ∫ f L dη ∋ f (L_behind − L_ahead) v_n: the side ahead shrinks.
-    let term = v.beta * f * t * jump * b.inv_pdf;
+    let term = v.beta * f * t * jump * b.inv_pdf * weight;
     for j in involved.iter() {
         let s = &mut d.slots[j];
         s.add_boundary(term * s.tb_dot, (term * s.tb_dot).abs());
@@ -301,7 +324,18 @@ impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
     }
     #[inline]
     fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
-        leibniz(g, &mut self.d, self.slots.all(), rng, leg, t_b);
+        let work = &mut self.scratch.work;
+        leibniz(g, &mut self.d, self.slots.all(), rng, leg, t_b, work);
+    }
+    #[inline]
+    fn visit(&mut self, _x: G::V) {
+        // A frozen walk is transport's nested walk.
+        let work = &mut self.scratch.work;
+        if self.frozen {
+            work.nested += 1;
+        } else {
+            work.main += 1;
+        }
     }
     #[inline]
     fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
@@ -333,7 +367,8 @@ impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
     }
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
-        attached_scatter(g, self.slots, &mut self.d, rng, v, self.frozen)
+        let work = &mut self.scratch.work;
+        attached_scatter(g, self.slots, &mut self.d, rng, v, self.frozen, work)
     }
 }
 
@@ -365,12 +400,13 @@ pub(super) fn attached_scatter<G: Boundaries>(
     rng: &mut PathRng,
     v: &Vertex<G>,
     frozen: bool,
+    work: &mut Work,
 ) -> G::V {
     if slots.is_empty() {
         return v.lobe.sample(rng);
     }
     let turning = frame_spins(g, slots, d, v, frozen);
-    corner_jump(g, slots, d, rng, v, turning, frozen);
+    corner_jump(g, slots, d, rng, v, turning, frozen, work);
     let w = v.lobe.sample(rng);
     attach(d, slots.all(), turning, w);
     w

@@ -16,9 +16,10 @@
 //! The sensor-position slots (`∂I/∂x`, …) follow rendering's rules.
 //! Book: chapter "Flatland: one deformation, three estimators", section
 //! "Transport"; in 3D, chapter "Three dimensions", section "Transport in 3D".
-use super::deform::{Deform, Scratch, Slots};
+use super::deform::{Deform, Slots};
+use super::nested::{Scratch, radiance};
 use super::rendering::{Rendering, attached_connect, attached_scatter, leibniz};
-use super::walk::{Hooks, Leg, Vertex, radiance, walk};
+use super::walk::{Hooks, Leg, Vertex, walk};
 use super::{Boundaries, Geometry, Hit, MediumId, NO_PRIM, Vector};
 use crate::rng::PathRng;
 
@@ -71,6 +72,9 @@ impl<G: Boundaries> Transport<'_, G> {
         drawn: Option<(f64, G::V)>,
     ) {
         let Leg { x, w, medium, beta } = *leg;
+        let Some(weight) = self.scratch.work.admit(rng) else {
+            return;
+        };
         let mut nested = self.scratch.take(self.d.len());
         for j in self.slots.moving(k).iter() {
             nested.slots[j].u = g.velocity(j, y);
@@ -80,7 +84,8 @@ impl<G: Boundaries> Transport<'_, G> {
         let nested = self.frozen_walk(g, rng, nested, start, w, medium, NO_PRIM, drawn);
         for j in self.slots.parameter_slots.iter() {
             let n = &nested.slots[j];
-            self.d.slots[j].add_boundary(-beta * n.boundary, (beta * n.boundary_scale).abs());
+            let (b, scale) = (n.boundary * weight, n.boundary_scale * weight);
+            self.d.slots[j].add_boundary(-beta * b, (beta * scale).abs());
         }
         self.scratch.give(nested);
     }
@@ -107,11 +112,15 @@ impl<G: Boundaries> Transport<'_, G> {
         // The in-scattered radiance just before the point, shared by the
         // slots (the nested walk's Leibniz term over its first leg).
         let scattered = match coefficients {
-            Some((ks, _)) if ks > 0.0 => {
-                let end = v.x - w * (0.5e-9 * g.size());
-                let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
-                beta * ks * radiance(g, rng, end, wi, medium, NO_PRIM)
-            }
+            Some((ks, _)) if ks > 0.0 => match self.scratch.work.admit(rng) {
+                Some(weight) => {
+                    let end = v.x - w * (0.5e-9 * g.size());
+                    let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
+                    let work = &mut self.scratch.work;
+                    beta * ks * radiance(g, work, rng, end, wi, medium, NO_PRIM) * weight
+                }
+                None => 0.0,
+            },
             _ => 0.0,
         };
         let ke = coefficients.map_or(0.0, |c| c.1);
@@ -185,7 +194,20 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     }
     #[inline]
     fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
-        leibniz(g, &mut self.d, self.slots.frozen_scene(), rng, leg, t_b);
+        let work = &mut self.scratch.work;
+        leibniz(
+            g,
+            &mut self.d,
+            self.slots.frozen_scene(),
+            rng,
+            leg,
+            t_b,
+            work,
+        );
+    }
+    #[inline]
+    fn visit(&mut self, _x: G::V) {
+        self.scratch.work.main += 1;
     }
     #[inline]
     fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
@@ -225,15 +247,29 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
         }
         let (w, before, beta) = (leg.w, leg.medium, leg.beta);
         let eps = g.nudge(y);
-        let side = |rng: &mut PathRng, medium: MediumId, at: G::V| match g.coefficients(medium) {
-            Some((ks, _)) if ks > 0.0 => {
+        let ks = |medium: MediumId| g.coefficients(medium).map_or(0.0, |c| c.0);
+        let work = &mut self.scratch.work;
+        let side = |work: &mut _, rng: &mut PathRng, medium: MediumId, at: G::V| {
+            if ks(medium) > 0.0 {
                 let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
-                ks * radiance(g, rng, at, wi, medium, NO_PRIM)
+                ks(medium) * radiance(g, work, rng, at, wi, medium, NO_PRIM)
+            } else {
+                0.0
             }
-            _ => 0.0,
         };
         let ke = |medium: MediumId| g.coefficients(medium).map_or(0.0, |c| c.1);
-        let scattered = side(rng, before, y - w * eps) - side(rng, after, y + w * eps);
+        // The in-scattered radiances by nested paths, as the work admits.
+        let scattered = if ks(before) > 0.0 || ks(after) > 0.0 {
+            match work.admit(rng) {
+                Some(weight) => {
+                    let l_before = side(work, rng, before, y - w * eps);
+                    (l_before - side(work, rng, after, y + w * eps)) * weight
+                }
+                None => 0.0,
+            }
+        } else {
+            0.0
+        };
         let dke = ke(before) - ke(after);
         for j in self.slots.parameter_slots.iter() {
             let s = &mut self.d.slots[j];
@@ -272,7 +308,8 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     }
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
-        attached_scatter(g, self.slots, &mut self.d, rng, v, false)
+        let work = &mut self.scratch.work;
+        attached_scatter(g, self.slots, &mut self.d, rng, v, false, work)
     }
     #[inline]
     fn reflected(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>, w: G::V) {
@@ -295,7 +332,9 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
         if self.moving_reflector {
             // … and its regular part: the radiance reflected at the moving
             // point in the turning frame, by a nested walk in the frozen
-            // scene; the path itself goes on fixed in space.
+            // scene (as the work admits it); the path itself goes on fixed
+            // in space.
+            let admitted = self.scratch.work.admit(rng);
             let mut nested = self.scratch.take(self.d.len());
             for j in params.iter() {
                 let s = &mut self.d.slots[j];
@@ -304,13 +343,19 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
                 s.u = G::V::ZERO;
                 nested.touch(j);
             }
-            let drawn = Some((super::Lobe::pdf(&v.lobe, w), v.x));
-            let nested = self.frozen_walk(g, rng, nested, v.x, w, v.medium, v.skip, drawn);
-            for j in params.iter() {
-                let n = &nested.slots[j];
-                self.d.slots[j]
-                    .add_boundary(v.beta * n.boundary, (v.beta * n.boundary_scale).abs());
-            }
+            let nested = match admitted {
+                Some(weight) => {
+                    let drawn = Some((super::Lobe::pdf(&v.lobe, w), v.x));
+                    let nested = self.frozen_walk(g, rng, nested, v.x, w, v.medium, v.skip, drawn);
+                    for j in params.iter() {
+                        let n = &nested.slots[j];
+                        let (b, scale) = (n.boundary * weight, n.boundary_scale * weight);
+                        self.d.slots[j].add_boundary(v.beta * b, (v.beta * scale).abs());
+                    }
+                    nested
+                }
+                None => nested,
+            };
             self.scratch.give(nested);
             self.moving_reflector = false;
         }

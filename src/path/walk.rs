@@ -432,125 +432,9 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
 /// a closed reflector of albedo 1 kept the path for the roulette's 10⁵
 /// events (rendering took 10⁴ times the intensity estimator's time).
 #[inline]
-fn behind_solid<G: Geometry>(g: &G, p: Prim, y: G::V, w: G::V) -> bool {
+pub(super) fn behind_solid<G: Geometry>(g: &G, p: Prim, y: G::V, w: G::V) -> bool {
     g.solid(p) && w.dot(g.normal(p, y)) > 0.0
 }
-
-/// The radiance leaving the surface of primitive `p` at its point `y`
-/// toward a viewer arriving along `w` (in `medium`): one path continued
-/// from that surface event. A corner's jump evaluates each side with it.
-pub fn surface_radiance<G: Geometry>(
-    g: &G,
-    rng: &mut PathRng,
-    y: G::V,
-    p: Prim,
-    w: G::V,
-    medium: MediumId,
-) -> f64 {
-    match g.surface(p) {
-        Surface::Emitter { radiance } => radiance,
-        Surface::Absorber | Surface::Transparent => 0.0,
-        Surface::Reflector { .. } if behind_solid(g, p, y, w) => 0.0,
-        Surface::Reflector { albedo } => {
-            let lobe = reflector_lobe(g, p, y, w, albedo);
-            let v = Vertex {
-                x: y,
-                medium,
-                skip: p,
-                lobe,
-                w_in: w,
-                frame: Frame::Surface(g.shape(p)),
-                beta: lobe.weight(),
-                at_sensor: false,
-                mixed: false,
-            };
-            let direct = next_event(g, rng, &v);
-            let wo = lobe.sample(rng);
-            let drawn = Some((lobe.pdf(wo), y));
-            direct + walk(g, &mut (), rng, y, wo, medium, p, v.beta, drawn)
-        }
-    }
-}
-
-// ANCHOR: reflected_jump
-/// The jump `L_b − L_a` of the radiance leaving a corner (2D) or crease
-/// (3D) of a reflector toward a viewer arriving along `w` (in `medium`),
-/// between its two faces: primitive `pa` at its point `ya` and `pb` at `yb`,
-/// each a hair from the corner.
-///
-/// The two reflected radiances share their draws: one emitter point, and one
-/// direction from the mixture `p = (p_a + p_b)/2` of the two cosine lobes,
-/// so each side's estimate is `f_s(η)/p(η) L_i(η)` plus its connection
-/// (MIS against `p`), both unbiased, and their difference is
-/// `(f_b − f_a)(η)/p(η) L_i(η)`: of the order of the faces' turning angle,
-/// where two separate paths (the general case of a corner jump) differ by
-/// `O(1)` from the first bounce on. One path gives `L_i` for both sides: a
-/// ray from either point along a direction in front of both faces meets
-/// neither face (the faces face the viewer on either side of the sight
-/// line), so both see the same first hit; a direction in front of one face
-/// only is that side's alone, traced from its point.
-pub fn reflected_jump<G: Geometry>(
-    g: &G,
-    rng: &mut PathRng,
-    (ya, pa): (G::V, Prim),
-    (yb, pb): (G::V, Prim),
-    w: G::V,
-    medium: MediumId,
-) -> f64 {
-    let (Surface::Reflector { albedo: ra }, Surface::Reflector { albedo: rb }) =
-        (g.surface(pa), g.surface(pb))
-    else {
-        unreachable!("reflected_jump takes two reflectors");
-    };
-    let la = reflector_lobe(g, pa, ya, w, ra);
-    let lb = reflector_lobe(g, pb, yb, w, rb);
-    let mixture = |e: G::V| 0.5 * (la.pdf(e) + lb.pdf(e));
-    // The side a ray along `e` leaves from: `a` unless only `b` faces `e`.
-    let from = |fa: f64| if fa > 0.0 { (ya, pa) } else { (yb, pb) };
-    let mut jump = 0.0;
-    // The connection: one emitter point for both sides.
-    if let Some((y, p)) = g.emitter_point(rng)
-        && let Surface::Emitter { radiance } = g.surface(p)
-    {
-        let unit = |x: G::V| {
-            let d = y - x;
-            d * (1.0 / d.length())
-        };
-        let (ea, eb) = (unit(ya), unit(yb));
-        let (fa, fb) = (la.value(ea), lb.value(eb));
-        let (pla, plb) = (g.light_pdf(ya, y, p), g.light_pdf(yb, y, p));
-        if (fa > 0.0 || fb > 0.0) && pla.is_finite() && plb.is_finite() {
-            let (x, skip) = from(fa);
-            let e = if fa > 0.0 { ea } else { eb };
-            let t = transmittance(g, &mut (), x, e, medium, skip, p);
-            if t > 0.0 {
-                let side = |f: f64, e: G::V, pl: f64| {
-                    if f > 0.0 {
-                        f * radiance / pl * mis(pl, mixture(e))
-                    } else {
-                        0.0
-                    }
-                };
-                jump += t * (side(fb, eb, plb) - side(fa, ea, pla));
-            }
-        }
-    }
-    // The reflected path: one direction from the mixture.
-    let e = if rng.random::<f64>() < 0.5 {
-        la.sample(rng)
-    } else {
-        lb.sample(rng)
-    };
-    let p = mixture(e);
-    let (fa, fb) = (la.value(e), lb.value(e));
-    if p > 0.0 && fa != fb {
-        let (x, skip) = from(fa);
-        let li = walk(g, &mut (), rng, x, e, medium, skip, 1.0, Some((p, x)));
-        jump += (fb - fa) / p * li;
-    }
-    jump
-}
-// ANCHOR_END: reflected_jump
 
 /// How many hits on primitives that hold a boundary point a sight line to
 /// it passes ([`reach`], and flatland's `Scene::sees_corner`): a corner
@@ -596,18 +480,4 @@ pub fn reach<G: Geometry>(
             _ => return Some(((-(tau + ke * left)).exp(), medium)),
         }
     }
-}
-
-/// One-sample estimate of the radiance arriving at `x` from direction `w`
-/// (the path travels along `w`), `x` lying in `medium`, leaving `skip`.
-#[inline]
-pub fn radiance<G: Geometry>(
-    g: &G,
-    rng: &mut PathRng,
-    x: G::V,
-    w: G::V,
-    medium: MediumId,
-    skip: Prim,
-) -> f64 {
-    walk(g, &mut (), rng, x, w, medium, skip, 1.0, None)
 }
