@@ -88,14 +88,14 @@ impl SceneSource {
     }
 
     /// The scene's dimension (2 or 3, by its sensor's point), if it says
-    /// ([`flat::file::dimension_of`]).
+    /// ([`crate::scene::file::dimension_of`]).
     pub fn dimension(&self) -> Result<Option<usize>, Error> {
         match self {
-            SceneSource::File(p) => flat::file::dimension(p),
+            SceneSource::File(p) => crate::scene::file::dimension(p),
             SceneSource::Json(text) => {
                 let value: serde_json::Value = serde_json::from_str(text)
                     .map_err(|e| Error::Scene(format!("the scene is not JSON: {e}")))?;
-                Ok(flat::file::dimension_of(&value))
+                Ok(crate::scene::file::dimension_of(&value))
             }
         }
     }

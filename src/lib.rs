@@ -68,6 +68,7 @@ pub mod rng;
 pub mod rod;
 mod rows;
 pub mod runner;
+pub mod scene;
 pub mod shard;
 pub mod stats;
 

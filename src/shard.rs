@@ -16,12 +16,12 @@
 //! a bit flipped in a file is an error, not another result.
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::flat::file::read_bytes_capped;
 use crate::image::{PixelSums, assemble, render_pixels};
 use crate::job::{ImageReport, Job, RenderJob};
 use crate::method::Method;
 use crate::report::{Header, Report};
 use crate::runner::{self, BLOCK, CHUNK, RunConfig, RunResult};
+use crate::scene::file::read_bytes_capped;
 use crate::stats::Moments;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};

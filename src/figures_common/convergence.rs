@@ -2,9 +2,9 @@
 //! run at 10³ to 10⁶ paths on one scene, σ and |mean − exact| against the
 //! number of paths, log–log.
 use super::{FigureOptions, get, run_method};
+use super::{METHODS, REFERENCE_COLOR, color};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::flat::figures::{METHODS, REFERENCE_COLOR, color};
 use crate::method::{Method, Problem};
 use crate::plot::{Legend, Panel, Series, quiet_corner, spread};
 use crate::rod::figures::convergence::path_counts;

@@ -2,9 +2,9 @@
 //! method ([`METHODS`]) timed on one thread on a few scenes, one panel of
 //! bars per scene, one group per quantity (`E` and every parameter).
 use super::{FigureOptions, run_method, save};
+use super::{METHODS, color};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::flat::figures::{METHODS, color};
 use crate::method::{Method, Problem};
 use crate::plot::{Figure, Panel, Series};
 use crate::runner::RunResult;

@@ -3,10 +3,10 @@
 //! singular configuration, the sensitivity to its parameter `p` judged;
 //! and the two rows of panels that show them (the per-path variance with
 //! its error bar, and the bias).
+use super::{DERIVATIVE_METHODS, REFERENCE_COLOR, color};
 use super::{FigureOptions, get, run_method};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::flat::figures::{DERIVATIVE_METHODS, REFERENCE_COLOR, color};
 use crate::method::Problem;
 use crate::plot::{Panel, Series, spread};
 use crate::stats::Estimate;

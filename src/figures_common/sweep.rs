@@ -3,10 +3,10 @@
 //! from the intensity estimator, `∂E/∂π` from the derivative methods) and
 //! drawn as markers with ±σ bars over the reference curves, one column of
 //! two panels (`E`, `∂E/∂π`) per sweep.
+use super::{DERIVATIVE_METHODS, color};
 use super::{FigureOptions, get, grid, run_method, z};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::flat::figures::{DERIVATIVE_METHODS, color};
 use crate::method::{Method, Problem};
 use crate::plot::{Panel, Series};
 use serde::Serialize;

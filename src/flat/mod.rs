@@ -4,6 +4,7 @@
 pub mod boundaries;
 pub mod bvh;
 pub mod cases;
+pub mod caveats;
 pub mod corners;
 pub mod exact;
 #[cfg(feature = "figures")]

@@ -31,8 +31,7 @@
 //! section "The warp field", *Steep gaps*). Next-event estimation's
 //! multiple importance sampling at the sensor weighs against `q`.
 use super::geometry::cross;
-use super::space::Plane;
-use crate::path::Geometry;
+use super::scene::Scene;
 use crate::rng::PathRng;
 use glam::DVec2;
 use rand::RngExt;
@@ -65,15 +64,15 @@ pub struct SensorGaps {
 }
 
 impl SensorGaps {
-    /// The mixture for `plane`'s irradiance sensor (empty for other
-    /// sensors, or when no gap is steep).
-    pub fn new(plane: &Plane) -> SensorGaps {
-        let scene = plane.scene();
+    /// The mixture for `scene`'s irradiance sensor (empty for other
+    /// sensors, or when no gap is steep), given the corners it sees in
+    /// angular order (`(angle, corner, shape)`, the plane's sensor knots).
+    pub fn new(scene: &Scene, knot_list: &[(f64, DVec2, u32)]) -> SensorGaps {
         let (point, n) = match scene.sensor() {
             super::scene::Sensor::Irradiance { point, normal } => (point, normal),
             _ => return SensorGaps::default(),
         };
-        let params = plane.parameters();
+        let params = scene.parameters().len();
         // The knots by ψ with every slot's angular velocity, the horizons
         // (still) at both ends.
         let psi = |q: DVec2| {
@@ -81,12 +80,12 @@ impl SensorGaps {
             cross(n, r).atan2(n.dot(r))
         };
         let mut knots: Vec<(f64, Vec<f64>)> = vec![(-FRAC_PI_2, vec![0.0; params])];
-        for &(_, q, k) in plane.sensor_knot_list() {
+        for &(_, q, k) in knot_list {
             let r = q - point;
             let rates = (0..params)
                 .map(|j| {
-                    if plane.parameter_shape(j) == k {
-                        cross(r, plane.velocity(j, q)) / r.length_squared()
+                    if scene.parameter_shape(j) == k {
+                        cross(r, scene.parameters()[j].motion.velocity(q)) / r.length_squared()
                     } else {
                         0.0
                     }
@@ -191,6 +190,7 @@ impl SensorGaps {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::flat::space::Plane;
     use rand::SeedableRng;
     use std::sync::Arc;
 
@@ -198,7 +198,10 @@ mod tests {
     /// occluder's line) inside the lamp's end: one steep gap.
     fn gaps() -> SensorGaps {
         let scene = crate::flat::cases::knots(1e-3).unwrap();
-        SensorGaps::new(&Plane::new(Arc::new(scene)))
+        {
+            let plane = Plane::new(Arc::new(scene));
+            SensorGaps::new(plane.scene(), plane.sensor_knot_list())
+        }
     }
 
     /// The sensor's cosine lobe.
@@ -263,7 +266,14 @@ mod tests {
     #[test]
     fn scenes_without_steep_gaps_keep_the_lobe() {
         let scene = crate::flat::cases::knots(0.1).unwrap();
-        assert_eq!(SensorGaps::new(&Plane::new(Arc::new(scene))).share, 0.0);
+        assert_eq!(
+            {
+                let plane = Plane::new(Arc::new(scene));
+                SensorGaps::new(plane.scene(), plane.sensor_knot_list())
+            }
+            .share,
+            0.0
+        );
     }
 
     const PI_16: f64 = std::f64::consts::PI / 16.0;

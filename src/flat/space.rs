@@ -255,8 +255,9 @@ impl Plane {
 
     /// The expectation method's direction density at the irradiance sensor.
     pub(super) fn sensor_gaps(&self) -> &super::sensor_gaps::SensorGaps {
-        self.sensor_gaps
-            .get_or_init(|| super::sensor_gaps::SensorGaps::new(self))
+        self.sensor_gaps.get_or_init(|| {
+            super::sensor_gaps::SensorGaps::new(&self.scene, self.sensor_knot_list())
+        })
     }
 
     /// The warp's knots at an irradiance sensor (see the field).

@@ -56,7 +56,7 @@ use rand::RngExt;
 mod lamp_parts;
 mod strata;
 
-pub(super) use lamp_parts::LAMP_EDGES;
+use super::space::LAMP_EDGES;
 use lamp_parts::{EdgeArc, LAMP_TRIANGLES};
 use strata::{Strata, Stratum};
 

@@ -26,9 +26,24 @@
 //!   through `x` on one side of a line, for the fibre warp's knots.
 //!
 //! Book: chapter "Three dimensions", section "Silhouette edges".
-use super::space::Edge;
-use crate::path::NO_PRIM;
+use crate::path::{NO_PRIM, Prim};
 use glam::DVec3;
+
+/// An edge of an opaque mesh: where the integrand over directions seen from
+/// a point can jump (a silhouette, an open edge, or a crease between two
+/// faces of different normals).
+#[derive(Debug, Clone, Copy)]
+pub struct Edge {
+    /// Its end points.
+    pub a: DVec3,
+    /// Second end.
+    pub b: DVec3,
+    /// The triangles (global primitive indices) on it; the second is
+    /// [`NO_PRIM`] for an open edge.
+    pub faces: [Prim; 2],
+    /// The mesh it belongs to.
+    pub shape: u32,
+}
 
 /// Most edges in a leaf.
 const LEAF: usize = 4;

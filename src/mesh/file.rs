@@ -46,7 +46,7 @@
 //! relative to the current directory.
 use super::scene::{Medium, Parameter, Scene, Sensor, Shape, Surface};
 use crate::error::Error;
-use crate::flat::file::{MAX_SCENE_BYTES, in_file, json_error, parse_file, read_bytes_capped};
+use crate::scene::file::{MAX_SCENE_BYTES, in_file, json_error, parse_file, read_bytes_capped};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

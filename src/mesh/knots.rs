@@ -7,7 +7,8 @@
 //! only past eight hidden ones); at the sensor, its precomputed view
 //! ([`super::sensor_view`]) does, with no ray. Book: chapter "Three
 //! dimensions", section "A warp on the sphere".
-use super::space::{Edge, Space};
+use super::edges::Edge;
+use super::space::Space;
 use super::warp::{Crossing, FibreKnot};
 use crate::path::NO_PRIM;
 use glam::DVec3;

@@ -19,9 +19,9 @@ pub mod boundaries;
 pub mod bvh;
 pub mod camera;
 pub mod cases;
+pub mod caveats;
 pub mod edges;
 pub mod exact;
-mod fd_view;
 #[cfg(feature = "figures")]
 pub mod figures;
 pub mod file;
@@ -29,6 +29,7 @@ pub mod knots;
 pub mod lobe;
 pub mod methods;
 mod obj_lines;
+pub mod poles;
 pub mod scene;
 pub mod sensor_view;
 pub mod space;

@@ -19,8 +19,8 @@
 //! half-lines is an interval; the visible parts are the complement of the
 //! union over triangles. A triangle on the edge (its own faces) cannot hide
 //! it and is skipped.
+use super::edges::Edge;
 use super::edges::{EdgeFacts, EdgeTree, is_discontinuity};
-use super::space::Edge;
 use crate::path::Prim;
 use glam::DVec3;
 

@@ -4,14 +4,14 @@
 //! discontinuities (silhouette and crease edges,
 //! [`Boundaries`](crate::path::Boundaries)) are in
 //! [`boundaries`](super::boundaries). Book: chapter "Three dimensions".
-use super::boundaries::LAMP_EDGES;
 use super::bvh::TriangleBvh;
 use super::camera::{CameraFrame, PixelEdges};
+pub use super::edges::Edge;
 use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
+use super::poles::{MAX_FIELDS, PoleRule};
 use super::scene::{Scene, Sensor as SceneSensor};
 use super::sensor_view::SensorView;
-use super::warp::{MAX_FIELDS, PoleRule};
 use crate::path::deform::SlotSet;
 use crate::path::thin_media::chord_bound;
 use crate::path::{Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface};
@@ -21,21 +21,10 @@ use rand::RngExt;
 use std::collections::HashMap;
 use std::sync::{Arc, OnceLock};
 
-/// An edge of an opaque mesh: where the integrand over directions seen from
-/// a point can jump (a silhouette, an open edge, or a crease between two
-/// faces of different normals).
-#[derive(Debug, Clone, Copy)]
-pub struct Edge {
-    /// Its end points.
-    pub a: DVec3,
-    /// Second end.
-    pub b: DVec3,
-    /// The triangles (global primitive indices) on it; the second is
-    /// [`NO_PRIM`] for an open edge.
-    pub faces: [Prim; 2],
-    /// The mesh it belongs to.
-    pub shape: u32,
-}
+/// Most edges in a tree for which the edge itself is also drawn by the
+/// length of its arc with a lamp behind (every edge's arc and lamp parts
+/// per draw); larger trees draw by the tree alone.
+pub(super) const LAMP_EDGES: usize = 64;
 
 /// Most edge or vertex touches of media boundaries one cast passes
 /// (`Space::touches_only`) before it reports the next hit as it is.

@@ -29,14 +29,14 @@
 //! the vertex's position, so no edge of a scene lies along the fibres by
 //! construction (an edge exactly on a fibre could not be moved by `V`;
 //! nearly on one, `α` is large: one of the method's heavy tails). One field
-//! per pole rule ([`PoleRule`]), each with its own knot search. Book: chapter "Three dimensions",
+//! per pole rule ([`PoleRule`](super::poles::PoleRule)), each with its own knot search. Book: chapter "Three dimensions",
 //! section "A warp on the sphere".
 use super::lobe::SpaceLobe;
+use super::poles::{MAX_FIELDS, pole};
 use super::space::{Space, Sphere};
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
 use glam::DVec3;
-use std::f64::consts::PI;
 
 /// A knot of a fibre: its polar angle (and cosine) and, for an edge
 /// crossing, the crossing.
@@ -66,53 +66,6 @@ pub struct Crossing {
     /// that slide's component along `e_θ`, over `r`, is `α`. Linear in `v`:
     /// `rate = (e_θ − m (dir·e_θ)/(dir·m)) / r`.
     pub(super) rate: DVec3,
-}
-
-/// Most fibre families one warp builds (distinct poles): the motions use at
-/// most four rules (the pseudo-random pole and the three axes); parameters
-/// beyond would share the pseudo-random one. Small, because a warp is
-/// copied per vertex.
-pub const MAX_FIELDS: usize = 4;
-
-/// How a parameter's fibres are laid out from a vertex `x`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum PoleRule {
-    /// A pseudo-random pole fixed by `x` (rotations).
-    Hashed,
-    /// A fixed pole (a translation's direction): every fibre plane holds
-    /// the velocity, so crossings at a silhouette's vertex slide alike.
-    Along(DVec3),
-    /// The pole toward a point (a scale's pivot): every fibre plane holds
-    /// `q − c`, the scale's velocity at each of its points.
-    Toward(DVec3),
-}
-
-impl PoleRule {
-    /// The rule for a parameter's motion.
-    pub fn of(motion: &super::scene::Motion) -> PoleRule {
-        use super::scene::Motion;
-        match *motion {
-            Motion::TranslateX => PoleRule::Along(DVec3::X),
-            Motion::TranslateY => PoleRule::Along(DVec3::Y),
-            Motion::TranslateZ => PoleRule::Along(DVec3::Z),
-            // Toward the pivot would hold a scale's velocities in every
-            // fibre plane too, but the pole then lies inside the mesh's
-            // silhouette and the silhouette's crossings of static edges
-            // (the lamp's) weigh more: measured on the closed-form scenes,
-            // its error bars covered worse (tests/mesh_coverage.rs).
-            Motion::Scale { .. } | Motion::Rotate { .. } => PoleRule::Hashed,
-        }
-    }
-
-    /// The pole at `x`.
-    #[inline]
-    pub(super) fn at(&self, x: DVec3) -> DVec3 {
-        match *self {
-            PoleRule::Hashed => pole(x),
-            PoleRule::Along(d) => d,
-            PoleRule::Toward(c) => (c - x).try_normalize().unwrap_or_else(|| pole(x)),
-        }
-    }
 }
 
 /// The warp at a vertex around a sampled direction: one fibre field per
@@ -149,27 +102,6 @@ fn meets_half_plane(d: DVec3, r: f64, u: DVec3, m: DVec3) -> bool {
         dm * dm + du * du
     };
     off <= r * r
-}
-
-/// A pseudo-random unit vector fixed by the bits of `x`.
-fn pole(x: DVec3) -> DVec3 {
-    let mut h: u64 = 0x9E37_79B9_7F4A_7C15;
-    for c in [x.x, x.y, x.z] {
-        h ^= (c + 0.0).to_bits();
-        h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        h ^= h >> 31;
-    }
-    let mut next = || {
-        h = h.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = h;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let z = 2.0 * next() - 1.0;
-    let phi = 2.0 * PI * next();
-    let s = (1.0 - z * z).max(0.0).sqrt();
-    DVec3::new(s * phi.cos(), s * phi.sin(), z)
 }
 
 impl Space {

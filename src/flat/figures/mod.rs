@@ -15,6 +15,7 @@ use crate::runner::RunResult;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+pub use crate::figures_common::{DERIVATIVE_METHODS, METHODS, REFERENCE_COLOR, color};
 pub use crate::rod::figures::{FigureFn, FigureOptions};
 
 pub mod against_pi;
@@ -24,37 +25,6 @@ pub mod efficiency;
 pub mod scene;
 pub mod stability;
 pub mod warp;
-
-/// The Monte Carlo methods in the figures' order.
-pub const METHODS: [Method; 5] = [
-    Method::Intensity,
-    Method::Expectation,
-    Method::Rendering,
-    Method::Transport,
-    Method::Fd,
-];
-
-/// The methods that estimate `∂E/∂π`.
-pub const DERIVATIVE_METHODS: [Method; 4] = [
-    Method::Expectation,
-    Method::Rendering,
-    Method::Transport,
-    Method::Fd,
-];
-
-/// Palette index of `method` in every flatland figure.
-pub fn color(method: Method) -> usize {
-    match method {
-        Method::Intensity => 0,
-        Method::Expectation => 1,
-        Method::Rendering => 2,
-        Method::Transport => 3,
-        Method::Fd => 4,
-    }
-}
-
-/// Palette index of analytic curves and reference lines (black).
-pub const REFERENCE_COLOR: usize = 6;
 
 /// Every flatland figure, in the book's order; returns the files written.
 pub fn all(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {

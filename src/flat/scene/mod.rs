@@ -15,42 +15,22 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 mod repr;
-mod shared;
 #[cfg(test)]
 mod tests;
 mod touch;
 mod validate;
 
-pub(crate) use shared::{GRADIENT_AXES, check_extent, check_parameter_name, check_pivot};
-pub use shared::{MAX_OFFSET, MAX_SIZE, MIN_SIZE};
-pub use validate::MAX_SCATTERING_EVENTS;
+pub use crate::scene::limits::{
+    MAX_OFFSET, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SCATTERING_EVENTS, MAX_SIZE, MIN_SIZE,
+};
+pub use crate::scene::material::Phase;
 
-/// Largest extinction coefficient times scene size accepted: beyond it a
-/// medium is opaque for every purpose and the weights underflow.
-pub const MAX_OPTICAL_THICKNESS: f64 = 1e4;
-
-/// Most parameters one path carries (with room for the sensor gradient's
-/// axes in 3D): 253.
-pub const MAX_PARAMETERS: usize = crate::path::deform::MAX_SLOTS - 3;
+/// The axes of flatland's sensor gradient (transport's `∂I/∂x`, `∂I/∂y`).
+pub(crate) const GRADIENT_AXES: [&str; 2] = ["x", "y"];
 
 /// What happens to light arriving at a shape's boundary: the path core's
-/// surfaces (serialised through the file form in `repr`).
+/// surfaces (serialised through the file form in `crate::scene::material`).
 pub use crate::path::Surface;
-
-/// Angular distribution of scattering in a medium (normalised over the circle).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(from = "repr::Phase", into = "repr::Phase")]
-pub enum Phase {
-    /// `p(θ) = 1/2π`.
-    #[default]
-    Isotropic,
-    /// The flatland Henyey–Greenstein function (the wrapped Cauchy law):
-    /// `p(θ) = (1 − g²) / (2π (1 + g² − 2g cos θ))`.
-    HenyeyGreenstein {
-        /// Mean cosine, `|g| < 1`.
-        g: f64,
-    },
-}
 
 /// A homogeneous medium filling a closed shape. A file gives its phase
 /// function as `phase = { kind = …, g = … }` or, as 3D files do, as `g` (0:
@@ -280,10 +260,7 @@ impl Clone for Scene {
     }
 }
 
-/// A scene error with message `msg`.
-fn config<T>(msg: String) -> Result<T, Error> {
-    Err(Error::Scene(msg))
-}
+use crate::scene::config;
 
 impl Scene {
     /// The same scene with parameter `j` changed by `delta` (its shape

@@ -5,15 +5,18 @@
 //! parameters, sensor, media), so a scene with several faults always reports
 //! the first of them.
 use super::{
-    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, GRADIENT_AXES, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS,
-    Medium, Motion, Parameter, Phase, Scene, Sensor, Shape, Surface, check_extent,
-    check_parameter_name, check_pivot, config,
+    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, GRADIENT_AXES, MAX_PARAMETERS, Medium, Motion, Parameter,
+    Scene, Sensor, Shape, Surface,
 };
 use crate::error::{Error, Num};
 use crate::flat::corners::CornerTree;
 use crate::flat::geometry::{
     LinearScan, NO_SEGMENT, RayCast, Segment, contains, cross, signed_area,
 };
+use crate::scene::camera::view_problem;
+use crate::scene::config;
+use crate::scene::limits::{check_extent, check_parameter_name, check_pivot};
+use crate::scene::material::{Coefficients, check_material, check_thickness};
 use glam::DVec2;
 
 impl Scene {
@@ -141,64 +144,16 @@ fn check_shape(k: usize, s: &Shape, repeated: bool) -> Result<(), Error> {
     for (i, &v) in s.vertices.iter().enumerate() {
         finite(&format!("shape {name:?} vertex {i}"), v)?;
     }
-    check_surface(name, &s.surface)?;
-    match (&s.medium, s.surface) {
-        (Some(m), Surface::Transparent) => {
-            if !s.closed {
-                return config(format!("shape {name:?} has a medium but is not closed"));
-            }
-            check_medium(name, m)
-        }
-        (Some(_), _) => config(format!(
-            "shape {name:?} has a medium behind an opaque surface: \
-             make its surface transparent"
-        )),
-        (None, Surface::Transparent) => config(format!(
-            "shape {name:?} is transparent but holds no medium: it would be invisible"
-        )),
-        (None, _) => Ok(()),
-    }
+    check_material(name, &s.surface, s.medium.map(coefficients), s.closed)
 }
 
-fn check_surface(name: &str, s: &Surface) -> Result<(), Error> {
-    match *s {
-        Surface::Emitter { radiance } if !(radiance >= 0.0 && radiance.is_finite()) => {
-            config(format!(
-                "shape {name:?}: radiance {} is not a finite number ≥ 0",
-                Num(radiance)
-            ))
-        }
-        Surface::Reflector { albedo } if !(0.0..=1.0).contains(&albedo) => config(format!(
-            "shape {name:?}: albedo {} is not in [0, 1]",
-            Num(albedo)
-        )),
-        _ => Ok(()),
+/// A medium's coefficients for the shared checks.
+fn coefficients(m: Medium) -> Coefficients {
+    Coefficients {
+        ks: m.ks,
+        ke: m.ke,
+        g: m.phase.g(),
     }
-}
-
-fn check_medium(name: &str, m: &Medium) -> Result<(), Error> {
-    if !(m.ks >= 0.0 && m.ks.is_finite()) {
-        return config(format!(
-            "shape {name:?}: κs = {} is not finite and ≥ 0",
-            Num(m.ks)
-        ));
-    }
-    if !(m.ke >= m.ks && m.ke.is_finite()) {
-        return config(format!(
-            "shape {name:?}: κe = {} must be finite and ≥ κs = {}",
-            Num(m.ke),
-            Num(m.ks)
-        ));
-    }
-    if let Phase::HenyeyGreenstein { g } = m.phase
-        && (g.abs() >= 1.0 || g.is_nan())
-    {
-        return config(format!(
-            "shape {name:?}: Henyey–Greenstein g = {} is not in (−1, 1)",
-            Num(g)
-        ));
-    }
-    Ok(())
 }
 
 /// Every segment of the scene, in shape order.
@@ -391,8 +346,7 @@ fn check_sensor(
         } => {
             finite("camera position", position)?;
             let view = [("width", width)];
-            if let Some(why) = crate::mesh::camera::view_problem(fov_deg, "a field of view", &view)
-            {
+            if let Some(why) = view_problem(fov_deg, "a field of view", &view) {
                 return config(why);
             }
             Sensor::Camera {
@@ -439,42 +393,12 @@ fn check_sensor(
 /// Rejects a medium thicker than [`MAX_OPTICAL_THICKNESS`] across the scene.
 fn check_optical_thickness(shapes: &[Shape], size: f64) -> Result<(), Error> {
     for s in shapes {
-        if let Some(m) = s.medium
-            && m.ke * size > MAX_OPTICAL_THICKNESS
-        {
-            return config(format!(
-                "shape {:?}: κe × scene size = {} exceeds {MAX_OPTICAL_THICKNESS}",
-                s.name,
-                Num(m.ke * size)
-            ));
-        }
-        // A path in a medium scatters about min(τs², κs/κa) times before it
-        // leaves or the roulette ends it (its weight falls by e^{−κa/κs} per
-        // event): beyond MAX_SCATTERING_EVENTS a run would not end.
         if let Some(m) = s.medium {
-            let tau = m.ks * size;
-            let ka = m.ke - m.ks;
-            let events = if ka > 0.0 {
-                (tau * tau).min(m.ks / ka)
-            } else {
-                tau * tau
-            };
-            if events > MAX_SCATTERING_EVENTS {
-                return config(format!(
-                    "shape {:?}: κs × scene size = {tau:.4e} with albedo {:.6}: a path would \
-                     scatter ~{events:.1e} times (at most {MAX_SCATTERING_EVENTS:e} are \
-                     supported); lower κs or raise the absorption",
-                    s.name,
-                    m.ks / m.ke
-                ));
-            }
+            check_thickness(&s.name, coefficients(m), size)?;
         }
     }
     Ok(())
 }
-
-/// Most scattering events a path is expected to need in one medium.
-pub const MAX_SCATTERING_EVENTS: f64 = 1e5;
 
 /// The medium shape around each shape (tested at its first vertex: shapes
 /// do not cross), and the one around the sensor at `p`.

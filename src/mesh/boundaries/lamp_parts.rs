@@ -3,19 +3,15 @@
 //! silhouette whose arc has a lamp behind it carries direct light across
 //! its jump; those parts are taken apart from the drawn point (book:
 //! chapter "Three dimensions", section "Silhouette edges").
+use super::super::edges::Edge;
 use super::super::edges::{EdgeFacts, EdgeTree};
-use super::super::space::{Edge, Space};
+use super::super::space::{LAMP_EDGES, Space};
 use crate::path::NO_PRIM;
 use glam::DVec3;
 
 /// Most emitter triangles for which the edge points are also drawn where a
 /// lamp lies behind them (a test per emitter triangle per draw).
 pub(super) const LAMP_TRIANGLES: usize = 16;
-
-/// Most edges in a tree for which the edge itself is also drawn by the
-/// length of its arc with a lamp behind (every edge's arc and lamp parts
-/// per draw); larger trees draw by the tree alone.
-pub(in crate::mesh) const LAMP_EDGES: usize = 64;
 
 /// An edge's arc seen from `x`: the directions `wa cos α + t sin α`,
 /// `α ∈ [0, arc]`, in the plane through `x` and the edge (unit normal `n`).

@@ -8,7 +8,7 @@
 //! The scenes are built in code ([`crate::mesh::cases`]): a black triangle
 //! occluder under the unit-square lamp, whose `E` and `∂E/∂π` have closed
 //! forms ([`crate::mesh::exact`]), and the configurations where the methods
-//! struggle. Colours per method are flatland's ([`color`]). The exception
+//! struggle. Colours per method are flatland's ([`color`], shared). The exception
 //! is [`camera`]: the showcase scene file's images, drawn pixel by pixel
 //! with plotters directly (PNG only).
 use super::Scene;
@@ -19,8 +19,9 @@ use crate::runner::RunResult;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-pub use crate::figures_common::{get, label, z};
-pub use crate::flat::figures::{DERIVATIVE_METHODS, METHODS, REFERENCE_COLOR, color};
+pub use crate::figures_common::{
+    DERIVATIVE_METHODS, METHODS, REFERENCE_COLOR, color, get, label, z,
+};
 pub use crate::rod::figures::{FigureFn, FigureOptions};
 
 pub mod against_pi;

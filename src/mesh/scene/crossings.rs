@@ -1,10 +1,10 @@
 //! Meshes that cross or touch: a sweep-and-prune broad phase over the
 //! meshes' boxes and then over their triangles, and the exact f64 test of
 //! each close pair ([`triangles_within`]).
-use super::Shape;
-use super::geometry::{segment_triangle_distance, triangles_within};
-use super::validate::{TOUCH_DISTANCE, bounds, config};
+use super::geometry::{bounds, segment_triangle_distance, triangles_within};
+use super::{Shape, TOUCH_DISTANCE};
 use crate::error::Error;
+use crate::scene::config;
 use glam::DVec3;
 
 /// An axis-aligned box, widened by a tolerance where compared.

@@ -15,6 +15,15 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
+/// The corners of the vertices' bounding box.
+pub(crate) fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
+    vertices
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        })
+}
+
 /// The point of triangle `[a, b, c]` closest to `p`.
 pub fn closest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
     let (ab, ac, ap) = (b - a, c - a, p - a);

@@ -20,11 +20,26 @@ mod repr;
 mod tests;
 mod validate;
 
-pub use crate::flat::scene::{
+pub use crate::scene::limits::{
     MAX_OFFSET, MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, MAX_SIZE, MIN_SIZE,
 };
-pub(crate) use validate::bounds;
-pub use validate::{DEGENERATE_AREA, TOUCH_DISTANCE};
+use crate::scene::material::Phase;
+pub(crate) use geometry::bounds;
+
+/// The sensor's axes, as transport's gradient names them.
+pub(crate) const AXES: [(&str, glam::DVec3); 3] = [
+    ("x", glam::DVec3::X),
+    ("y", glam::DVec3::Y),
+    ("z", glam::DVec3::Z),
+];
+
+/// The axes of 3D's sensor gradient (transport's `∂I/∂x`, `∂I/∂y`, `∂I/∂z`).
+pub(crate) const GRADIENT_AXES: [&str; 3] = ["x", "y", "z"];
+pub use validate::DEGENERATE_AREA;
+
+/// Two meshes closer than `TOUCH_DISTANCE × size` (the scene's size) touch:
+/// at such distances a ray tracer's offsets cannot tell them apart.
+pub const TOUCH_DISTANCE: f64 = 1e-12;
 
 /// What happens to light arriving at a mesh: the path core's surfaces, read
 /// and written in the same file form as flatland's.
@@ -54,7 +69,7 @@ struct MediumFile {
     #[serde(default)]
     g: Option<f64>,
     #[serde(default)]
-    phase: Option<crate::flat::Phase>,
+    phase: Option<Phase>,
 }
 
 impl TryFrom<MediumFile> for Medium {
@@ -68,8 +83,8 @@ impl TryFrom<MediumFile> for Medium {
                 );
             }
             (Some(g), None) => g,
-            (None, Some(crate::flat::Phase::HenyeyGreenstein { g })) => g,
-            (None, Some(crate::flat::Phase::Isotropic) | None) => 0.0,
+            (None, Some(phase)) => phase.g(),
+            (None, None) => 0.0,
         };
         Ok(Medium {
             ks: m.ks,

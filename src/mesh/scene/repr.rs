@@ -1,30 +1,13 @@
-//! The file forms of [`Motion`](super::Motion) and [`Sensor`](super::Sensor):
-//! internally tagged (`kind = "rotate"`) with every variant a struct
-//! variant, as flatland's (`crate::flat::scene`'s `repr`): serde's
-//! `deny_unknown_fields` lets unknown fields through on the unit variants of
-//! an internally tagged enum (serde-rs/serde#2123), so `{ kind =
-//! "translate_x", pivot = [0, 0, 0] }` would load without a word. The
-//! surface's file form is flatland's, shared through the path core.
-//!
-//! The fields of tagged enums are read through [`field`]: serde buffers a
-//! tagged table before reading it, so the parser's own message ("invalid
-//! type: string, expected f64") would not say which field is wrong.
+//! The file forms of [`Motion`](super::Motion) and [`Sensor`](super::Sensor),
+//! written as `crate::scene::repr` says: every variant of a tagged enum a
+//! struct variant (else `{ kind = "translate_x", pivot = [0, 0, 0] }` would
+//! load without a word), fields read through `crate::scene::repr::field`
+//! so that errors name them. Surfaces and phase functions have one file form
+//! for both dimensions, in `crate::scene::material`.
+use crate::scene::repr::fields;
 use glam::DVec3;
-use serde::de::Error as _;
-use serde::{Deserialize, Deserializer, Serialize};
+use serde::{Deserialize, Serialize};
 
-/// Deserializes a field, naming it in the error.
-fn field<'de, D: Deserializer<'de>, T: Deserialize<'de>>(name: &str, d: D) -> Result<T, D::Error> {
-    T::deserialize(d).map_err(|e| D::Error::custom(format_args!("field `{name}`: {e}")))
-}
-
-macro_rules! fields {
-    ($($name:ident: $t:ty),*) => {$(
-        fn $name<'de, D: Deserializer<'de>>(d: D) -> Result<$t, D::Error> {
-            field(stringify!($name), d)
-        }
-    )*};
-}
 fields!(axis: DVec3, pivot: Option<DVec3>, point: DVec3, direction: DVec3, normal: DVec3);
 fields!(position: DVec3, look_at: DVec3, up: DVec3, fov_deg: f64, width: u32, height: u32);
 

@@ -21,12 +21,12 @@
 //! messages are the user's too. Vertex indices in later messages are those
 //! of the welded mesh.
 use super::crossings::{Aabb, check_crossings, check_self_crossings};
-use super::geometry::{point_triangle_distance, signed_volume, winding_number};
-use super::{
-    MAX_OPTICAL_THICKNESS, MAX_PARAMETERS, Medium, Motion, Parameter, Scene, Sensor, Shape, Surface,
-};
+use super::geometry::{bounds, point_triangle_distance, signed_volume, winding_number};
+use super::{MAX_PARAMETERS, Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
 use crate::error::{Error, Num};
-use crate::flat::scene::{MAX_SCATTERING_EVENTS, check_parameter_name};
+use crate::scene::config;
+use crate::scene::limits::{check_extent, check_parameter_name, check_pivot};
+use crate::scene::material::{Coefficients, check_material, check_thickness};
 use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 
@@ -36,17 +36,9 @@ use std::collections::{HashMap, HashSet};
 /// volume a closed mesh must enclose.
 pub const DEGENERATE_AREA: f64 = 1e-12;
 
-/// Two meshes closer than `TOUCH_DISTANCE × size` (the scene's size) touch:
-/// at such distances a ray tracer's offsets cannot tell them apart.
-pub const TOUCH_DISTANCE: f64 = 1e-12;
-
 /// A sensor closer than `SENSOR_DISTANCE × size` to a triangle lies on it
 /// (flatland's rule).
 const SENSOR_DISTANCE: f64 = 1e-9;
-
-pub(super) fn config<T>(msg: String) -> Result<T, Error> {
-    Err(Error::Scene(msg))
-}
 
 fn show(p: DVec3) -> String {
     format!("[{}, {}, {}]", Num(p.x), Num(p.y), Num(p.z))
@@ -90,10 +82,10 @@ impl Scene {
     /// statement of its faces), a closed mesh enclosing no volume, a medium
     /// on an open or opaque mesh, a transparent mesh without a medium,
     /// coefficients out of range (κs < 0, κe < κs, |g| ≥ 1, radiance < 0,
-    /// albedo ∉ `[0, 1]`), a medium too thick ([`MAX_OPTICAL_THICKNESS`]), a
+    /// albedo ∉ `[0, 1]`), a medium too thick ([`MAX_OPTICAL_THICKNESS`](super::MAX_OPTICAL_THICKNESS)), a
     /// size outside [`MIN_SIZE`](super::MIN_SIZE)..[`MAX_SIZE`](super::MAX_SIZE) or
     /// too far from the origin ([`MAX_OFFSET`](super::MAX_OFFSET)), two meshes that cross or
-    /// touch ([`TOUCH_DISTANCE`]), a mesh that crosses, touches
+    /// touch ([`TOUCH_DISTANCE`](super::TOUCH_DISTANCE)), a mesh that crosses, touches
     /// or folds onto itself (a T-junction, an unwelded seam),
     /// bad parameters (too many, empty or
     /// repeated names, unknown shapes, zero or non-finite axes and pivots),
@@ -182,57 +174,17 @@ fn check_shape(k: usize, s: &Shape, repeated: bool) -> Result<(), Error> {
     for (i, &v) in s.vertices.iter().enumerate() {
         finite(&format!("shape {name:?} vertex {i}"), v)?;
     }
-    check_surface(name, &s.surface)?;
-    match (&s.medium, s.surface) {
-        (Some(m), Surface::Transparent) => check_medium(name, m),
-        (Some(_), _) => config(format!(
-            "shape {name:?} has a medium behind an opaque surface: \
-             make its surface transparent"
-        )),
-        (None, Surface::Transparent) => config(format!(
-            "shape {name:?} is transparent but holds no medium: it would be invisible"
-        )),
-        (None, _) => Ok(()),
-    }
+    // Closedness is the topology's to check, after welding.
+    check_material(name, &s.surface, s.medium.map(coefficients), true)
 }
 
-fn check_surface(name: &str, s: &Surface) -> Result<(), Error> {
-    match *s {
-        Surface::Emitter { radiance } if !(radiance >= 0.0 && radiance.is_finite()) => {
-            config(format!(
-                "shape {name:?}: radiance {} is not a finite number ≥ 0",
-                Num(radiance)
-            ))
-        }
-        Surface::Reflector { albedo } if !(0.0..=1.0).contains(&albedo) => config(format!(
-            "shape {name:?}: albedo {} is not in [0, 1]",
-            Num(albedo)
-        )),
-        _ => Ok(()),
+/// A medium's coefficients for the shared checks.
+fn coefficients(m: Medium) -> Coefficients {
+    Coefficients {
+        ks: m.ks,
+        ke: m.ke,
+        g: m.g,
     }
-}
-
-fn check_medium(name: &str, m: &Medium) -> Result<(), Error> {
-    if !(m.ks >= 0.0 && m.ks.is_finite()) {
-        return config(format!(
-            "shape {name:?}: κs = {} is not finite and ≥ 0",
-            Num(m.ks)
-        ));
-    }
-    if !(m.ke >= m.ks && m.ke.is_finite()) {
-        return config(format!(
-            "shape {name:?}: κe = {} must be finite and ≥ κs = {}",
-            Num(m.ke),
-            Num(m.ks)
-        ));
-    }
-    if m.g.abs() >= 1.0 || m.g.is_nan() {
-        return config(format!(
-            "shape {name:?}: Henyey–Greenstein g = {} is not in (−1, 1)",
-            Num(m.g)
-        ));
-    }
-    Ok(())
 }
 
 /// Merges the vertices at the same position (`−0.0` and `0.0` alike),
@@ -259,15 +211,6 @@ pub(super) fn weld(shape: &mut Shape) {
     shape.vertices = vertices;
 }
 
-/// The corners of the vertices' bounding box.
-pub(crate) fn bounds(vertices: &[DVec3]) -> (DVec3, DVec3) {
-    vertices
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        })
-}
-
 /// The largest extent of the vertices' bounding box, within
 /// [`MIN_SIZE`](super::MIN_SIZE)..[`MAX_SIZE`](super::MAX_SIZE), no farther
 /// from the origin than [`MAX_OFFSET`](super::MAX_OFFSET) times it.
@@ -277,7 +220,7 @@ fn scene_size(shapes: &[Shape]) -> Result<f64, Error> {
         let (l, h) = bounds(&s.vertices);
         (lo, hi) = (lo.min(l), hi.max(h));
     }
-    crate::flat::scene::check_extent(
+    check_extent(
         (hi - lo).max_element(),
         lo.abs().max(hi.abs()).max_element(),
     )
@@ -411,12 +354,7 @@ fn resolve_parameters(
     let mut resolved = Vec::with_capacity(parameters.len());
     let mut names = HashSet::with_capacity(parameters.len());
     for (j, p) in parameters.iter().enumerate() {
-        check_parameter_name(
-            j,
-            &p.name,
-            &p.shape,
-            &crate::mesh::methods::AXES.map(|a| a.0),
-        )?;
+        check_parameter_name(j, &p.name, &p.shape, &super::GRADIENT_AXES)?;
         if !names.insert(p.name.as_str()) {
             return config(format!("two parameters are named {:?}", p.name));
         }
@@ -430,7 +368,7 @@ fn resolve_parameters(
             let c = pivot.unwrap_or_else(|| shapes[k].centroid());
             finite(&format!("parameter {:?} pivot", p.name), c)?;
             let distance = (c - shapes[k].centroid()).abs().max_element();
-            crate::flat::scene::check_pivot(&p.name, distance, size)?;
+            check_pivot(&p.name, distance, size)?;
             Ok(Some(c))
         };
         let motion = match p.motion {
@@ -531,29 +469,8 @@ fn check_sensor(
 /// [`MAX_SCATTERING_EVENTS`] times (flatland's rules).
 fn check_optical_thickness(shapes: &[Shape], size: f64) -> Result<(), Error> {
     for s in shapes {
-        let Some(m) = s.medium else { continue };
-        if m.ke * size > MAX_OPTICAL_THICKNESS {
-            return config(format!(
-                "shape {:?}: κe × scene size = {} exceeds {MAX_OPTICAL_THICKNESS}",
-                s.name,
-                Num(m.ke * size)
-            ));
-        }
-        let tau = m.ks * size;
-        let ka = m.ke - m.ks;
-        let events = if ka > 0.0 {
-            (tau * tau).min(m.ks / ka)
-        } else {
-            tau * tau
-        };
-        if events > MAX_SCATTERING_EVENTS {
-            return config(format!(
-                "shape {:?}: κs × scene size = {tau:.4e} with albedo {:.6}: a path would \
-                 scatter ~{events:.1e} times (at most {MAX_SCATTERING_EVENTS:e} are \
-                 supported); lower κs or raise the absorption",
-                s.name,
-                m.ks / m.ke
-            ));
+        if let Some(m) = s.medium {
+            check_thickness(&s.name, coefficients(m), size)?;
         }
     }
     Ok(())

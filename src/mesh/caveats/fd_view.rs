@@ -15,7 +15,7 @@
 //! caveat where none was needed, not a wrong number). Book: chapter
 //! "Reliability", section "Finite differences across a change of
 //! visibility".
-use super::scene::{Scene, Shape};
+use crate::mesh::scene::{Scene, Shape};
 use crate::path::Surface;
 use glam::DVec3;
 use std::collections::HashMap;

@@ -9,6 +9,8 @@ use crate::estimator::Estimator;
 use std::fmt;
 use std::str::FromStr;
 
+pub mod model;
+
 /// A Monte Carlo estimation method. The CLI's `--method` takes these names
 /// (`clap::ValueEnum`); the variants' one-line doc comments are its help.
 ///

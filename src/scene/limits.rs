@@ -1,5 +1,7 @@
-//! The checks and limits that flatland's and 3D's validation share: the
-//! scene's extent, a pivot's distance, a parameter's name.
+//! The limits a scene of either dimension is held to, and the checks of
+//! what flatland's and 3D's parameters share: the scene's extent, a
+//! pivot's distance, a parameter's name. Book: chapter "Reliability",
+//! sections "Scale" and "Runs that end".
 use super::config;
 use crate::error::Error;
 
@@ -60,15 +62,22 @@ pub const MAX_SIZE: f64 = 1e60;
 /// 86σ).
 pub const MAX_OFFSET: f64 = 1e6;
 
-/// The axes of flatland's sensor gradient (transport's `∂I/∂x`, `∂I/∂y`).
-pub(crate) const GRADIENT_AXES: [&str; 2] = ["x", "y"];
+/// Largest extinction coefficient times scene size accepted: beyond it a
+/// medium is opaque for every purpose and the weights underflow.
+pub const MAX_OPTICAL_THICKNESS: f64 = 1e4;
+
+/// Most scattering events a path is expected to need in one medium.
+pub const MAX_SCATTERING_EVENTS: f64 = 1e5;
+
+/// Most parameters one path carries (with room for the sensor gradient's
+/// axes in 3D): 253.
+pub const MAX_PARAMETERS: usize = crate::path::deform::MAX_SLOTS - 3;
 
 /// Rejects the name of parameter `j` if it is empty or if its output would
 /// be taken for another quantity's: a gradient axis of `axes` (its
 /// `∂I/∂x` row would stand beside the sensor gradient's, which transport
 /// prints under the same name) or `I` (a rendering's intensity image, keyed
-/// `I` beside the parameters' images in Python). Flatland's and 3D's
-/// validation both.
+/// `I` beside the parameters' images in Python).
 pub(crate) fn check_parameter_name(
     j: usize,
     p: &str,
