@@ -58,4 +58,9 @@ def test_a_call_that_holds_the_gil_stops_the_counter():
     import random
 
     xs = [random.random() for _ in range(1_500_000)]
-    assert ticks_during(lambda: sorted(xs)) <= 3
+    # The bound is the release tests' (`> 20`): the control shows that a
+    # call holding the GIL stays below it. A held GIL still lets a few ticks
+    # through at the hand-overs before and after the call, more when the
+    # machine is loaded and the main thread waits for a core to take the
+    # GIL back (8 were seen with two cargo builds running; `<= 3` failed).
+    assert ticks_during(lambda: sorted(xs)) <= 20

@@ -3,7 +3,8 @@
 //! and where a central difference may straddle a change of visibility
 //! (`view_change`). The estimators attach their messages to the
 //! quantities concerned (`Estimator::caveats`). Book: chapter
-//! "Reliability", sections "Ties" and "Finite differences across a change
+//! "Choosing a method" (row 4, corners aligned) and chapter "When not to
+//! trust a number", section "Finite differences across a change
 //! of visibility".
 use super::scene::Scene;
 use crate::error::Num;

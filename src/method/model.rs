@@ -3,7 +3,7 @@
 //! [`Problem`] implementation builds every method's estimator (the
 //! intensity loop, the three derivative schemes on the path core, and
 //! [`finite_difference`]'s central differences). Book: chapter
-//! "Architecture", and for what each method computes, chapters "Flatland"
+//! "Where the code lives", and for what each method computes, chapters "Flatland"
 //! and "Three dimensions".
 use super::{Method, Problem};
 use crate::error::Error;

@@ -5,7 +5,7 @@
 //! (`crate::flat::file`) and the 3D loader (`crate::mesh::file`, which also
 //! reads OBJ meshes through `read_bytes_capped`) build their scenes from
 //! what it parses; [`dimension`] tells them apart. Book: chapter "Scene
-//! files".
+//! files: a reference".
 use crate::error::Error;
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! The limits a scene of either dimension is held to, and the checks of
 //! what flatland's and 3D's parameters share: the scene's extent, a
-//! pivot's distance, a parameter's name. Book: chapter "Reliability",
-//! sections "Scale" and "Runs that end".
+//! pivot's distance, a parameter's name. Book: chapter "When not to
+//! trust a number", sections "Scale" and "Runs that end".
 use super::config;
 use crate::error::Error;
 

@@ -3,8 +3,8 @@
 //! a surface's bounds, a medium's coefficients and thickness, the pairing
 //! of the two (a medium sits behind a transparent surface and nothing
 //! else), and how peaked a phase function the expectation method takes.
-//! Book: chapter "Flatland", section "Scene files"; chapter "Reliability",
-//! sections "Runs that end" and "Peaked phase functions".
+//! Book: chapter "Scene files: a reference"; chapter "When not to trust a
+//! number", sections "Runs that end" and "Peaked phase functions".
 use super::config;
 use super::limits::{MAX_OPTICAL_THICKNESS, MAX_SCATTERING_EVENTS};
 use super::repr::fields;

@@ -4,13 +4,14 @@
 //! phase functions ([`material`]), the cameras' bounds ([`camera`]) and the
 //! file forms' shared pieces (`repr`). `crate::flat` and `crate::mesh` build
 //! their scenes on it and keep only what is theirs (polygons, meshes, OBJ
-//! files); neither imports the other. Book: chapter "Architecture".
+//! files); neither imports the other. Book: chapter "Where the code lives".
 use crate::error::Error;
 
 pub mod camera;
 pub mod file;
 pub mod limits;
 pub mod material;
+pub mod parameter;
 pub(crate) mod repr;
 
 /// A scene error with message `msg`.

@@ -142,17 +142,10 @@ impl Motion {
     }
 }
 
-/// A shape parameter π whose sensitivity `∂I/∂π` is estimated.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Parameter {
-    /// Unique name (the key of its sensitivity).
-    pub name: String,
-    /// Name of the shape it moves (with its medium).
-    pub shape: String,
-    /// How it moves it.
-    pub motion: Motion,
-}
+/// A shape parameter π whose sensitivity `∂I/∂π` is estimated: the
+/// dimension-neutral [`crate::scene::parameter::Parameter`] with flatland's
+/// [`Motion`].
+pub type Parameter = crate::scene::parameter::Parameter<Motion>;
 
 /// What is measured, at a static point.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

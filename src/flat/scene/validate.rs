@@ -5,8 +5,8 @@
 //! parameters, sensor, media), so a scene with several faults always reports
 //! the first of them.
 use super::{
-    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, GRADIENT_AXES, MAX_PARAMETERS, Medium, Motion, Parameter,
-    Scene, Sensor, Shape, Surface,
+    BVH_THRESHOLD, CORNER_TREE_THRESHOLD, GRADIENT_AXES, Medium, Motion, Parameter, Scene, Sensor,
+    Shape, Surface,
 };
 use crate::error::{Error, Num};
 use crate::flat::corners::CornerTree;
@@ -15,8 +15,9 @@ use crate::flat::geometry::{
 };
 use crate::scene::camera::view_problem;
 use crate::scene::config;
-use crate::scene::limits::{check_extent, check_parameter_name, check_pivot};
+use crate::scene::limits::{check_extent, check_pivot};
 use crate::scene::material::{Coefficients, check_material, check_thickness};
+use crate::scene::parameter;
 use glam::DVec2;
 
 impl Scene {
@@ -253,64 +254,29 @@ fn check_crossings(shapes: &[Shape], segments: &[Segment], owner: &[u32]) -> Res
 }
 
 /// The parameters with their pivots resolved (a shape's centroid where none
-/// is given), and the index of the shape each moves; rejects too many
-/// parameters, empty or duplicate names, unknown shapes and non-finite
+/// is given), and the index of the shape each moves; rejects what
+/// [`crate::scene::parameter::resolve_parameters`] does and non-finite
 /// pivots.
 fn resolve_parameters(
     shapes: &[Shape],
     parameters: &[Parameter],
     size: f64,
 ) -> Result<(Vec<Parameter>, Vec<u32>), Error> {
-    let mut parameter_shape = Vec::with_capacity(parameters.len());
-    let mut resolved = Vec::with_capacity(parameters.len());
-    if parameters.len() > MAX_PARAMETERS {
-        return config(format!(
-            "{} parameters: at most {MAX_PARAMETERS} are supported",
-            parameters.len()
-        ));
-    }
-    let mut names = std::collections::HashSet::with_capacity(parameters.len());
-    for (j, p) in parameters.iter().enumerate() {
-        check_parameter_name(j, &p.name, &p.shape, &GRADIENT_AXES)?;
-        if !names.insert(p.name.as_str()) {
-            return config(format!("two parameters are named {:?}", p.name));
-        }
-        let Some(k) = shapes.iter().position(|s| s.name == p.shape) else {
-            return config(format!(
-                "parameter {:?} moves shape {:?}, which does not exist",
-                p.name, p.shape
-            ));
+    let names: Vec<&str> = shapes.iter().map(|s| s.name.as_str()).collect();
+    parameter::resolve_parameters(&names, parameters, &GRADIENT_AXES, |p, k| {
+        let pivot = |pivot: Option<DVec2>| -> Result<Option<DVec2>, Error> {
+            let c = pivot.unwrap_or_else(|| shapes[k].centroid());
+            finite(&format!("parameter {:?} pivot", p.name), c)?;
+            let distance = (c - shapes[k].centroid()).abs().max_element();
+            check_pivot(&p.name, distance, size)?;
+            Ok(Some(c))
         };
-        let motion = match p.motion {
-            Motion::Rotate { pivot } => {
-                let c = pivot.unwrap_or_else(|| shapes[k].centroid());
-                finite(&format!("parameter {:?} pivot", p.name), c)?;
-                check_pivot(
-                    &p.name,
-                    (c - shapes[k].centroid()).abs().max_element(),
-                    size,
-                )?;
-                Motion::Rotate { pivot: Some(c) }
-            }
-            Motion::Scale { pivot } => {
-                let c = pivot.unwrap_or_else(|| shapes[k].centroid());
-                finite(&format!("parameter {:?} pivot", p.name), c)?;
-                check_pivot(
-                    &p.name,
-                    (c - shapes[k].centroid()).abs().max_element(),
-                    size,
-                )?;
-                Motion::Scale { pivot: Some(c) }
-            }
+        Ok(match p.motion {
+            Motion::Rotate { pivot: c } => Motion::Rotate { pivot: pivot(c)? },
+            Motion::Scale { pivot: c } => Motion::Scale { pivot: pivot(c)? },
             m => m,
-        };
-        parameter_shape.push(k as u32);
-        resolved.push(Parameter {
-            motion,
-            ..p.clone()
-        });
-    }
-    Ok((resolved, parameter_shape))
+        })
+    })
 }
 
 /// The sensor with its direction or normal normalised; rejects a sensor

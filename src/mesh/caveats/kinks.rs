@@ -1,7 +1,7 @@
 //! Where `I` or the sensor's gradient may have a kink because the sensor
 //! lies in the plane of a face: [`kinks`] (a moved face seen edge-on) and
 //! [`plane_kinks_of_the_gradient`] (the sensor moving across a face's
-//! plane). Book: chapter "Reliability", section "Ties".
+//! plane). Book: chapter "Choosing a method" (row 4).
 use crate::estimator::Quantity;
 use crate::mesh::scene::{AXES, Scene};
 

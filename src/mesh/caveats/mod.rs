@@ -4,7 +4,8 @@
 //! sensor ([`edge_ties`]), and where a central difference may straddle a
 //! change of visibility (`fd`, `fd_view`). The estimators attach their
 //! messages to the quantities concerned (`Estimator::caveats`). Book:
-//! chapter "Reliability", sections "Ties" and "Finite differences across a
+//! chapter "Choosing a method" (row 4) and chapter "When not to trust a
+//! number", section "Finite differences across a
 //! change of visibility".
 pub(crate) mod fd;
 pub(crate) mod fd_view;

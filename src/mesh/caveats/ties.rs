@@ -1,6 +1,6 @@
 //! Where `I` may have a kink because two meshes' edges lie in one plane
 //! through the sensor and overlap as seen from it: the 3D twin of
-//! flatland's corner ties. Book: chapter "Reliability", section "Ties".
+//! flatland's corner ties. Book: chapter "Choosing a method" (row 4).
 use super::kinks::crosses;
 use crate::estimator::Quantity;
 use crate::mesh::edges::is_discontinuity;

@@ -22,11 +22,12 @@
 //! of the welded mesh.
 use super::crossings::{Aabb, check_crossings, check_self_crossings};
 use super::geometry::{bounds, point_triangle_distance, signed_volume, winding_number};
-use super::{MAX_PARAMETERS, Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
+use super::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
 use crate::error::{Error, Num};
 use crate::scene::config;
-use crate::scene::limits::{check_extent, check_parameter_name, check_pivot};
+use crate::scene::limits::{check_extent, check_pivot};
 use crate::scene::material::{Coefficients, check_material, check_thickness};
+use crate::scene::parameter;
 use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 
@@ -337,33 +338,15 @@ fn orient(shapes: &mut [Shape], closed: &[bool]) -> Result<Vec<f64>, Error> {
 
 /// The parameters with their pivots resolved (a mesh's vertex centroid
 /// where none is given) and axes normalised, and the index of the shape
-/// each moves; rejects too many parameters, empty or duplicate names,
-/// unknown shapes, non-finite pivots, zero or non-finite axes.
+/// each moves; rejects what [`crate::scene::parameter::resolve_parameters`]
+/// does, non-finite pivots, zero or non-finite axes.
 fn resolve_parameters(
     shapes: &[Shape],
     parameters: &[Parameter],
     size: f64,
 ) -> Result<(Vec<Parameter>, Vec<u32>), Error> {
-    if parameters.len() > MAX_PARAMETERS {
-        return config(format!(
-            "{} parameters: at most {MAX_PARAMETERS} are supported",
-            parameters.len()
-        ));
-    }
-    let mut parameter_shape = Vec::with_capacity(parameters.len());
-    let mut resolved = Vec::with_capacity(parameters.len());
-    let mut names = HashSet::with_capacity(parameters.len());
-    for (j, p) in parameters.iter().enumerate() {
-        check_parameter_name(j, &p.name, &p.shape, &super::GRADIENT_AXES)?;
-        if !names.insert(p.name.as_str()) {
-            return config(format!("two parameters are named {:?}", p.name));
-        }
-        let Some(k) = shapes.iter().position(|s| s.name == p.shape) else {
-            return config(format!(
-                "parameter {:?} moves shape {:?}, which does not exist",
-                p.name, p.shape
-            ));
-        };
+    let names: Vec<&str> = shapes.iter().map(|s| s.name.as_str()).collect();
+    parameter::resolve_parameters(&names, parameters, &super::GRADIENT_AXES, |p, k| {
         let pivot = |pivot: Option<DVec3>| -> Result<Option<DVec3>, Error> {
             let c = pivot.unwrap_or_else(|| shapes[k].centroid());
             finite(&format!("parameter {:?} pivot", p.name), c)?;
@@ -371,21 +354,15 @@ fn resolve_parameters(
             check_pivot(&p.name, distance, size)?;
             Ok(Some(c))
         };
-        let motion = match p.motion {
+        Ok(match p.motion {
             Motion::Rotate { axis, pivot: c } => Motion::Rotate {
                 axis: unit(&format!("parameter {:?} axis", p.name), axis)?,
                 pivot: pivot(c)?,
             },
             Motion::Scale { pivot: c } => Motion::Scale { pivot: pivot(c)? },
             m => m,
-        };
-        parameter_shape.push(k as u32);
-        resolved.push(Parameter {
-            motion,
-            ..p.clone()
-        });
-    }
-    Ok((resolved, parameter_shape))
+        })
+    })
 }
 
 /// Whether `p` is inside the closed (outward-oriented) mesh `s`: its
