@@ -1,8 +1,11 @@
 //! The `geosens` binary: JSON shape, agreement with the library and the exact
 //! solution, thread-count independence, and rejection of bad input.
-use geosens::rod::{Direction, Rod, exact};
+use geosens::rod::{Direction, Probe, Rod, exact};
+use geosens::{Estimate, Method, Quantity, RunConfig, RunResult, run};
 use serde_json::Value;
+use std::iter::Peekable;
 use std::process::{Command, Output};
+use std::sync::Arc;
 
 /// The thick rod and probe most tests use.
 const PROBE: [&str; 10] = [
@@ -315,9 +318,266 @@ fn compare_runs() {
     for word in ["thin rod", "thick rod", "exact", "transport", "reliable"] {
         assert!(text.contains(word), "missing {word:?}");
     }
+    // Every number of the table against the library: the same scenes, the
+    // same seed and path count (on one thread: results do not depend on it).
+    let cfg = RunConfig::new(2000, 1).unwrap().threads(1);
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let totals = assert_rod_tables(&mut lines, &cfg);
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("per method over the 16 probes")
+    );
+    lines.next(); // column titles
+    for (m, (z, bad)) in Method::UNBIASED.iter().zip(totals) {
+        let line = lines.next().unwrap();
+        let t: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(t[0], m.name(), "{line}");
+        assert_printed(t[2], z, &format!("{} max z", m.name()));
+        assert_eq!(t[3].parse::<usize>().ok(), Some(bad), "{line}");
+    }
+    assert_mesh_tables(&mut lines, &cfg);
+    assert!(lines.next().unwrap().starts_with("total wall time"));
+    assert_eq!(lines.next(), None);
     assert_rejected(&["compare", "--paths", "1"], 1, &["paths = 1"]);
     assert_rejected(&["compare", "--effort", "0"], 1, &["effort = 0"]);
     assert_rejected(&["compare", "--effort", "nan"], 1, &["effort = NaN"]);
+}
+
+/// Asserts the rod tables of `geosens compare` (the next of `lines`) print
+/// the exact solution and the library's runs with `cfg` on the thin and
+/// thick rods; returns each method's largest z-score and number of
+/// unreliable estimates, for the summary.
+fn assert_rod_tables<'a>(
+    lines: &mut impl Iterator<Item = &'a str>,
+    cfg: &RunConfig,
+) -> [(f64, usize); 4] {
+    let quantities = geosens::report::rod_quantities();
+    let mut totals = [(0.0f64, 0usize); 4];
+    for (name, ks, ke) in [("thin", 0.07, 0.1), ("thick", 2.1, 3.0)] {
+        let header = lines.next().unwrap();
+        assert!(header.starts_with(&format!("{name} rod: ")), "{header}");
+        assert_eq!(runs_of(header), (cfg.paths, cfg.seed), "{header}");
+        lines.next(); // column titles
+        let rod = Rod::new(ks, ke, 2.0).unwrap();
+        for x in [0.0, 1.0, 1.9, 2.0] {
+            for omega in [Direction::Right, Direction::Left] {
+                let exact = exact::solve(&rod, x, omega);
+                let exact = [exact.intensity, exact.sensitivity, exact.gradient_x];
+                let label = format!("{x}, {:+}", omega.sign());
+                let what = format!("{name} rod at {label}");
+                let line = lines.next().unwrap();
+                let mut tokens = line.split_whitespace().peekable();
+                let first: Vec<&str> = tokens.by_ref().take(3).collect();
+                assert_eq!(first.join(" "), format!("{label} exact"), "{line}");
+                for (cell, value) in cells(&mut tokens, 3).iter().zip(exact) {
+                    let Cell::Value(v) = cell else {
+                        panic!("{what}: exact {cell:?}")
+                    };
+                    assert_printed(v, value, &format!("{what}: exact"));
+                }
+                assert_eq!(tokens.next(), Some("-"), "{what}: {line}");
+                let probe = Probe::new(&rod, x, omega).unwrap();
+                for (m, total) in Method::UNBIASED.iter().zip(&mut totals) {
+                    let r = run(m.estimator((rod, probe)).unwrap().as_ref(), cfg).unwrap();
+                    assert_eq!(r.paths, cfg.paths);
+                    let what = format!("{what}, {}", m.name());
+                    let line = lines.next().unwrap();
+                    let mut tokens = line.split_whitespace().peekable();
+                    assert_eq!(tokens.next(), Some(m.name()), "{what}: {line}");
+                    let printed = cells(&mut tokens, 3);
+                    for ((cell, q), exact) in printed.iter().zip(&quantities).zip(exact) {
+                        let Some(e) = r.get(q) else {
+                            assert_eq!(*cell, Cell::Absent, "{what} {q}");
+                            continue;
+                        };
+                        let z = e.z_score(exact);
+                        assert_estimate(cell, &e, z, &format!("{what} {q}"));
+                        total.0 = total.0.max(z);
+                        total.1 += usize::from(!e.is_reliable());
+                    }
+                    let reliable = r.estimates.iter().all(|(_, e)| e.is_reliable());
+                    let word = if reliable { "yes" } else { "no" };
+                    assert_eq!(tokens.next(), Some(word), "{what}: {line}");
+                }
+            }
+        }
+    }
+    totals
+}
+
+/// Asserts the 3D tables of `geosens compare` (the next of `lines`) print
+/// the closed forms and the library's runs with `cfg` of every method.
+fn assert_mesh_tables<'a>(lines: &mut impl Iterator<Item = &'a str>, cfg: &RunConfig) {
+    for (what, scene, e, s) in mesh_scenes() {
+        let header = lines.next().unwrap();
+        assert!(header.starts_with(&format!("3D: {what}")), "{header}");
+        assert_eq!(runs_of(header), (cfg.paths, cfg.seed), "{header}");
+        lines.next(); // column titles
+        let scene = Arc::new(scene);
+        let runs: Vec<RunResult> = Method::ALL
+            .iter()
+            .map(|m| run(m.estimator(Arc::clone(&scene)).unwrap().as_ref(), cfg).unwrap())
+            .collect();
+        let mut quantities = vec![(Quantity::Intensity, "E".to_owned(), e)];
+        for (p, &x) in scene.parameters().iter().zip(&s) {
+            quantities.push((Quantity::sensitivity(&p.name), format!("∂E/∂{}", p.name), x));
+        }
+        for (q, label, exact) in &quantities {
+            let mut first = true;
+            for r in &runs {
+                let Some(est) = r.get(q) else { continue };
+                assert_eq!(r.paths, cfg.paths);
+                let what = format!("3D {what}: {label} by {}", r.method);
+                let line = lines.next().unwrap();
+                let mut tokens = line.split_whitespace().peekable();
+                if first {
+                    assert_eq!(tokens.next(), Some(label.as_str()), "{what}: {line}");
+                    let closed = tokens.next().unwrap();
+                    assert_printed(closed, *exact, &format!("{what}: closed form"));
+                    first = false;
+                }
+                assert_eq!(tokens.next(), Some(r.method), "{what}: {line}");
+                // Signed, and 0 where the estimate is the closed form.
+                let z = if est.mean == *exact {
+                    0.0
+                } else {
+                    (est.mean - exact) / est.stderr
+                };
+                assert_estimate(&cells(&mut tokens, 1)[0], &est, z, &what);
+            }
+        }
+    }
+}
+
+/// The `(paths, seed)` of a table's title: `…; 2000 paths per run, seed 1`.
+fn runs_of(header: &str) -> (u64, u64) {
+    let (_, tail) = header.rsplit_once("; ").unwrap();
+    let t: Vec<&str> = tail.split_whitespace().collect();
+    assert_eq!(t[1..5], ["paths", "per", "run,", "seed"], "{header}");
+    (t[0].parse().unwrap(), t[5].parse().unwrap())
+}
+
+/// One cell of `geosens compare`'s tables, as printed.
+#[derive(Debug, PartialEq)]
+enum Cell<'a> {
+    /// `-`: the method does not estimate the quantity.
+    Absent,
+    /// A bare value: an exact row's.
+    Value(&'a str),
+    /// `mean ± stderr z score`, the score followed by `!` if the error bar
+    /// is flagged unreliable.
+    Estimate {
+        mean: &'a str,
+        stderr: &'a str,
+        z: &'a str,
+        unreliable: bool,
+    },
+}
+
+/// The next `n` cells of a row's `tokens`.
+fn cells<'a>(tokens: &mut Peekable<impl Iterator<Item = &'a str>>, n: usize) -> Vec<Cell<'a>> {
+    (0..n)
+        .map(|_| {
+            let first = tokens.next().expect("a cell");
+            if first == "-" {
+                return Cell::Absent;
+            }
+            if tokens.next_if_eq(&"±").is_none() {
+                return Cell::Value(first);
+            }
+            let stderr = tokens.next().expect("a standard error");
+            assert_eq!(tokens.next(), Some("z"));
+            let z = tokens.next().expect("a z-score");
+            Cell::Estimate {
+                mean: first,
+                stderr,
+                z: z.trim_end_matches('!'),
+                unreliable: z.ends_with('!'),
+            }
+        })
+        .collect()
+}
+
+/// Asserts `cell` prints `e`: its mean, standard error and z-score `z` to
+/// the digits printed, and its reliability flag.
+fn assert_estimate(cell: &Cell, e: &Estimate, z: f64, what: &str) {
+    let Cell::Estimate {
+        mean,
+        stderr,
+        z: score,
+        unreliable,
+    } = cell
+    else {
+        panic!("{what}: {cell:?} for {e:?}")
+    };
+    assert_printed(mean, e.mean, &format!("{what}: mean"));
+    assert_printed(stderr, e.stderr, &format!("{what}: stderr"));
+    if z.is_finite() {
+        assert_printed(score, z, &format!("{what}: z"));
+    } else {
+        assert_eq!(*score, "-", "{what}: z of {e:?}");
+    }
+    assert_eq!(*unreliable, !e.is_reliable(), "{what}: {e:?}");
+}
+
+/// Asserts the printed `token` is `value` to the digits printed: within half
+/// a unit of its last digit (`0.0e0`, printed only for 0, exactly 0).
+fn assert_printed(token: &str, value: f64, what: &str) {
+    let printed: f64 = token
+        .parse()
+        .unwrap_or_else(|_| panic!("{what}: {token:?} is not a number"));
+    let (digits, exponent) = token
+        .split_once('e')
+        .map_or((token, 0), |(m, e)| (m, e.parse::<i32>().unwrap()));
+    let decimals = digits.split_once('.').map_or(0, |(_, d)| d.len()) as i32;
+    let half_unit = 0.5 * 10f64.powi(exponent - decimals);
+    let exact_zero = token.contains('e') && printed == 0.0;
+    assert!(
+        if exact_zero {
+            value == 0.0
+        } else {
+            (printed - value).abs() <= half_unit * (1.0 + 1e-9)
+        },
+        "{what}: printed {token}, library {value}"
+    );
+}
+
+/// The 3D scenes of `geosens compare`, with their closed forms: the title's
+/// description, the scene, `E` and every `∂E/∂π`.
+fn mesh_scenes() -> [(&'static str, geosens::mesh::Scene, f64, Vec<f64>); 2] {
+    use geosens::mesh::cases::{TriangleOccluder, box_shape, lamp, up};
+    use geosens::mesh::exact::BoxScene;
+    use geosens::mesh::{Parameter, Scene, Surface};
+    use glam::DVec3;
+    let t = TriangleOccluder::NOMINAL;
+    let (e, s) = t.exact().unwrap();
+    let b = BoxScene::shipped(DVec3::new(0.2, -0.1, 1.0), 0.3);
+    let parameters = ["box_tx", "box_ty", "box_tz", "box_rot", "box_scale"]
+        .iter()
+        .zip(b.motions())
+        .map(|(n, m)| Parameter {
+            name: (*n).into(),
+            shape: "box".into(),
+            motion: m,
+        })
+        .collect();
+    let cube = box_shape("box", b.corners(), Surface::Absorber, None);
+    [
+        (
+            "black triangle",
+            t.scene(&[0, 1, 2]).unwrap(),
+            e,
+            s.to_vec(),
+        ),
+        (
+            "black cube",
+            Scene::new(vec![lamp(), cube], parameters, up()).unwrap(),
+            b.irradiance().unwrap(),
+            b.sensitivities().unwrap().to_vec(),
+        ),
+    ]
 }
 
 #[test]
@@ -511,7 +771,8 @@ fn issue_11_inputs_end_with_an_answer_or_a_message() {
         1,
         &["∂I/∂length", "NaN", "overflow"],
     );
-    // The thick rod in units of 1e200: the exact solution is the thick rod's.
+    // The thick rod in units of 1e200: the exact solution is the thick rod's
+    // (the library's on the unit-scale rod).
     let out = geosens(&[
         "rod", "--method", "exact", "--ks", "2.1e-200", "--ke", "3e-200", "--length", "2e200",
         "--x", "1e200", "--omega", "1", "--json",
@@ -519,7 +780,12 @@ fn issue_11_inputs_end_with_an_answer_or_a_message() {
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let i = v["intensity"]["mean"].as_f64().unwrap();
-    assert!((i - 0.19277216180520562).abs() < 1e-13, "I = {i}");
+    let unit = exact::solve(&Rod::new(2.1, 3.0, 2.0).unwrap(), 1.0, Direction::Right);
+    assert!(
+        (i - unit.intensity).abs() <= 1e-13 * unit.intensity,
+        "I = {i}, thick rod's {}",
+        unit.intensity
+    );
     // κe π̃ = 10⁴ with albedo ½: 10⁴ paths end (they took 22 ms each).
     let out = geosens(&[
         "rod",
