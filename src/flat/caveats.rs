@@ -9,6 +9,7 @@
 use super::scene::Scene;
 use crate::error::Num;
 use crate::estimator::Quantity;
+use crate::method::model::Step;
 
 /// Largest angle (rad) between two corners' sight lines from the sensor
 /// that [`ties`] takes for an alignment: the rounding of an exact one.
@@ -83,13 +84,8 @@ pub fn ties(scene: &Scene) -> Vec<(Quantity, String)> {
 /// angular order, or what a radiance sensor's ray hits first) differs
 /// between the two displaced scenes: the quotient then straddles a change of
 /// visibility, and its error bar cannot see it.
-pub(crate) fn view_change(
-    scene: &Scene,
-    j: usize,
-    h: f64,
-    plus: &Scene,
-    minus: &Scene,
-) -> Option<String> {
+pub(crate) fn view_change(scene: &Scene, step: &Step<'_, Scene>) -> Option<String> {
+    let &Step { j, h, plus, minus } = step;
     let name = &scene.parameters()[j].name;
     let k = scene.parameter_shape(j) as usize;
     let shape = &scene.shapes()[k];

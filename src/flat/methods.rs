@@ -22,7 +22,7 @@ use super::space::Plane;
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::fd::CentralDifference;
-use crate::method::model::{self, Model};
+use crate::method::model::{self, Model, Step};
 use crate::path::Surface;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::thin_media::chord_bound;
@@ -88,8 +88,8 @@ impl Model for Scene {
         ties(plane.scene())
     }
     fn fd_view(&self) {}
-    fn fd_caveat(&self, j: usize, h: f64, plus: &Self, minus: &Self, _: &()) -> Option<String> {
-        view_change(self, j, h, plus, minus)
+    fn fd_caveat(&self, step: &Step<'_, Self>, _: &()) -> Option<String> {
+        view_change(self, step)
     }
     fn fd_nominal_caveats(_: &Plane) -> Vec<(Quantity, String)> {
         Vec::new()

@@ -27,7 +27,7 @@ use super::space::Space;
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::fd::CentralDifference;
-use crate::method::model::{self, Model};
+use crate::method::model::{self, Model, Step};
 use crate::path::Surface;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::thin_media::chord_bound;
@@ -103,18 +103,12 @@ impl Model for Scene {
     fn fd_view(&self) -> Self::FdView {
         outlines(self)
     }
-    fn fd_caveat(
-        &self,
-        j: usize,
-        h: f64,
-        plus: &Self,
-        minus: &Self,
-        outlines: &Self::FdView,
-    ) -> Option<String> {
+    fn fd_caveat(&self, step: &Step<'_, Self>, outlines: &Self::FdView) -> Option<String> {
+        let &Step { j, h, .. } = step;
         passes_sensor(self, j, h)
-            .or_else(|| turns_face(self, j, h, plus, minus))
+            .or_else(|| turns_face(self, step))
             .or_else(|| outruns_lamp(self, j, h))
-            .or_else(|| view_crossing(self, j, h, plus, minus, outlines))
+            .or_else(|| view_crossing(self, step, outlines))
     }
     fn fd_nominal_caveats(space: &Space) -> Vec<(Quantity, String)> {
         let mut caveats = kinks(space.scene());

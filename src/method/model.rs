@@ -71,21 +71,26 @@ pub trait Model: Sized + Send + Sync + 'static {
     fn derivative_caveats(geometry: &Self::Geometry, gradient: bool) -> Vec<(Quantity, String)>;
     /// The shared data of [`Model::fd_caveat`].
     fn fd_view(&self) -> Self::FdView;
-    /// Why the central difference along parameter `j` (half step `h`, the
-    /// displaced scenes `plus` and `minus`) may not estimate the
+    /// Why the central difference of `step` may not estimate the
     /// derivative, if it may not (the thin-medium caveat aside, which
     /// [`finite_difference`] adds).
-    fn fd_caveat(
-        &self,
-        j: usize,
-        h: f64,
-        plus: &Self,
-        minus: &Self,
-        view: &Self::FdView,
-    ) -> Option<String>;
+    fn fd_caveat(&self, step: &Step<'_, Self>, view: &Self::FdView) -> Option<String>;
     /// The caveats of the nominal scene that also hold for finite
     /// differences (3D: faces seen edge-on, tied edges).
     fn fd_nominal_caveats(geometry: &Self::Geometry) -> Vec<(Quantity, String)>;
+}
+
+/// One parameter's central difference: the parameter `j`, the half step
+/// `h` and the scenes displaced by `±h`.
+pub struct Step<'a, S> {
+    /// The parameter.
+    pub j: usize,
+    /// The half step.
+    pub h: f64,
+    /// The scene displaced by `+h`.
+    pub plus: &'a S,
+    /// The scene displaced by `−h`.
+    pub minus: &'a S,
 }
 
 impl<S: Model> Problem for Arc<S> {
@@ -187,8 +192,14 @@ pub fn finite_difference<S: Model>(scene: &Arc<S>, step: f64) -> Result<CentralD
                 .map_err(|e| invalid_displacement("scene", name, delta, &note, e))
         };
         let (plus, minus) = (displaced(h)?, displaced(-h)?);
+        let displaced = Step {
+            j,
+            h,
+            plus: &*plus,
+            minus: &*minus,
+        };
         if let Some(c) = scene
-            .fd_caveat(j, h, &plus, &minus, &view)
+            .fd_caveat(&displaced, &view)
             .or_else(|| thin_medium(&**scene, j))
         {
             caveats.push((name.to_owned(), c));

@@ -64,3 +64,19 @@ pub(crate) fn resolve_parameters<M>(
     }
     Ok((resolved, parameter_shape))
 }
+
+/// Parameter `j` of `parameters`, to be displaced by `delta`; refuses an
+/// index out of range and a displacement that is not finite.
+pub(crate) fn displaced<M>(
+    parameters: &[Parameter<M>],
+    j: usize,
+    delta: f64,
+) -> Result<&Parameter<M>, Error> {
+    let Some(p) = parameters.get(j) else {
+        return config(format!("no parameter {j}"));
+    };
+    if !delta.is_finite() {
+        return config(format!("displacement {delta} is not finite"));
+    }
+    Ok(p)
+}

@@ -253,18 +253,11 @@ impl Clone for Scene {
     }
 }
 
-use crate::scene::config;
-
 impl Scene {
     /// The same scene with parameter `j` changed by `delta` (its shape
     /// moved), validated again.
     pub fn displaced(&self, j: usize, delta: f64) -> Result<Scene, Error> {
-        let Some(p) = self.parameters.get(j) else {
-            return config(format!("no parameter {j}"));
-        };
-        if !delta.is_finite() {
-            return config(format!("displacement {delta} is not finite"));
-        }
+        let p = crate::scene::parameter::displaced(&self.parameters, j, delta)?;
         let mut shapes = self.shapes.clone();
         let k = self.parameter_shape[j] as usize;
         for v in &mut shapes[k].vertices {

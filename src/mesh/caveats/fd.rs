@@ -7,6 +7,7 @@
 use crate::error::Num;
 use crate::mesh::scene::geometry::point_triangle_distance;
 use crate::mesh::scene::{Scene, bounds};
+use crate::method::model::Step;
 
 /// Why the central difference along parameter `j` (half step `h`) may not
 /// estimate the derivative: as seen from the sensor, the half step turns a
@@ -82,13 +83,8 @@ pub(crate) fn passes_sensor(scene: &Scene, j: usize, h: f64) -> Option<String> {
 /// tetrahedron whose face turned edge-on 10⁻⁴ rad from the nominal
 /// rotation gave −0.0017 ± 0.0003 at the default step against the exact
 /// −0.0054, marked reliable. Flatland's twin is its sensor-view test.
-pub(crate) fn turns_face(
-    scene: &Scene,
-    j: usize,
-    h: f64,
-    plus: &Scene,
-    minus: &Scene,
-) -> Option<String> {
+pub(crate) fn turns_face(scene: &Scene, step: &Step<'_, Scene>) -> Option<String> {
+    let &Step { j, h, plus, minus } = step;
     let k = scene.parameter_shape(j) as usize;
     let x = scene.sensor().point();
     let facing = |s: &Scene, i: usize| {

@@ -16,6 +16,7 @@
 //! "Reliability", section "Finite differences across a change of
 //! visibility".
 use crate::mesh::scene::{Scene, Shape};
+use crate::method::model::Step;
 use crate::path::Surface;
 use glam::DVec3;
 use std::collections::HashMap;
@@ -82,20 +83,17 @@ fn side(a: DVec3, b: DVec3, v: DVec3) -> f64 {
     a.cross(b).dot(v).signum()
 }
 
-/// Why the central difference along parameter `j` of `scene` (half step
-/// `h`, displaced scenes `plus` and `minus`; `outlines` the nominal
-/// scene's, from [`outlines`]) may straddle a kink: an outline edge of the
+/// Why the central difference of `step` on `scene` (`outlines` the
+/// nominal scene's, from [`outlines`]) may straddle a kink: an outline edge of the
 /// moved mesh sweeps across the line of an outline edge of another opaque
 /// mesh, or the reverse, between the two displaced scenes, as seen from
 /// the sensor, their arcs overlapping.
 pub fn view_crossing(
     scene: &Scene,
-    j: usize,
-    h: f64,
-    plus: &Scene,
-    minus: &Scene,
+    step: &Step<'_, Scene>,
     outlines: &[Vec<[u32; 2]>],
 ) -> Option<String> {
+    let &Step { j, h, plus, minus } = step;
     let k = scene.parameter_shape(j) as usize;
     let x = scene.sensor().point();
     let (mp, mm) = (&plus.shapes()[k], &minus.shapes()[k]);

@@ -259,12 +259,7 @@ impl Scene {
     /// The same scene with parameter `j` changed by `delta` (its mesh
     /// moved), validated again.
     pub fn displaced(&self, j: usize, delta: f64) -> Result<Scene, Error> {
-        let Some(p) = self.parameters.get(j) else {
-            return Err(Error::Scene(format!("no parameter {j}")));
-        };
-        if !delta.is_finite() {
-            return Err(Error::Scene(format!("displacement {delta} is not finite")));
-        }
+        let p = crate::scene::parameter::displaced(&self.parameters, j, delta)?;
         let mut shapes = self.shapes.clone();
         let k = self.parameter_shape[j] as usize;
         for v in &mut shapes[k].vertices {
