@@ -4,7 +4,7 @@
 //! estimator, the very loop flatland runs, gives the closed-form irradiance
 //! under a square lamp, with next-event estimation and without.
 use geosens::path::intensity::{IntensityEstimator, PlainEstimator};
-use geosens::path::{Geometry, Hit, Lobe, MediumId, Prim, Sensor, Surface};
+use geosens::path::{Coefficients, Geometry, Hit, Lobe, MediumId, Prim, Sensor, Surface};
 use geosens::rng::PathRng;
 use geosens::{Quantity, RunConfig, run};
 use glam::DVec3;
@@ -131,7 +131,7 @@ impl Geometry for Triangles {
         let t = &self.tris[p as usize].0;
         (t[1] - t[0]).cross(t[2] - t[0]).normalize()
     }
-    fn coefficients(&self, _m: MediumId) -> Option<(f64, f64)> {
+    fn coefficients(&self, _m: MediumId) -> Option<Coefficients> {
         None
     }
     fn medium_chord(&self, _m: MediumId) -> f64 {

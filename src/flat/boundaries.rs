@@ -11,7 +11,7 @@ use super::scene::{Phase, Sensor as FlatSensor};
 use super::space::{Knot, Plane};
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, NO_PRIM, Side};
+use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, NO_PRIM, Side};
 use glam::DVec2;
 use std::f64::consts::TAU;
 
@@ -248,12 +248,11 @@ impl Boundaries for Plane {
         &self,
         warp: &FlatWarp,
         _slot: usize,
-        x: DVec2,
+        vertex: MovingVertex<DVec2>,
         w: DVec2,
-        u: DVec2,
-        spin: f64,
         velocity: impl Fn(DVec2, u32) -> DVec2,
     ) -> (DVec2, f64) {
+        let MovingVertex { x, u, spin } = vertex;
         // Knot values: a corner's angular velocity, or the frame's at a
         // horizon (which keeps the integrand's domain in place).
         let rate = |q: DVec2, k: u32| {
@@ -598,7 +597,12 @@ pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
                     DVec2::ZERO
                 }
             };
-            let (wd, _) = plane.warp_velocity(&field, 0, x, w, DVec2::ZERO, 0.0, velocity);
+            let still = MovingVertex {
+                x,
+                u: DVec2::ZERO,
+                spin: 0.0,
+            };
+            let (wd, _) = plane.warp_velocity(&field, 0, still, w, velocity);
             wd.dot(perp(w))
         })
         .collect()

@@ -9,7 +9,7 @@ use super::lobe::FlatLobe;
 use super::scene::{Phase, Scene, Sensor as FlatSensor};
 use crate::path::deform::SlotSet;
 use crate::path::thin_media::chord_bound;
-use crate::path::{Geometry, Hit, MediumId, PixelSample, Prim, Sensor, Surface};
+use crate::path::{Coefficients, Geometry, Hit, MediumId, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec2;
 use rand::RngExt;
@@ -380,8 +380,10 @@ impl Geometry for Plane {
         s.closed && s.surface != Surface::Transparent
     }
     #[inline]
-    fn coefficients(&self, m: MediumId) -> Option<(f64, f64)> {
-        self.scene.medium(m).map(|m| (m.ks, m.ke))
+    fn coefficients(&self, m: MediumId) -> Option<Coefficients> {
+        self.scene
+            .medium(m)
+            .map(|m| Coefficients { ks: m.ks, ke: m.ke })
     }
     #[inline]
     fn medium_chord(&self, m: MediumId) -> f64 {

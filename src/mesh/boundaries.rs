@@ -39,7 +39,7 @@
 //!
 //! Each point's `inv_pdf` is the inverse of its density per unit arc
 //! length (a point taken every time: of its position alone), so the path
-//! core's corner term (`rendering::corner_jump`) is, unchanged, the edge
+//! core's corner term (`corner_jump`, `path/rendering.rs`) is, unchanged, the edge
 //! term, and the sum over the points is unbiased.
 //! Book: chapter "Three dimensions", section "Silhouette edges".
 use super::edges::{EdgeTree, is_discontinuity};
@@ -48,7 +48,9 @@ use super::space::Space;
 use super::warp::SpaceWarp;
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, NO_PRIM, Prim, Side};
+use crate::path::{
+    Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, NO_PRIM, Prim, Side,
+};
 use crate::rng::PathRng;
 use glam::DVec3;
 use rand::RngExt;
@@ -515,13 +517,11 @@ impl Boundaries for Space {
         &self,
         warp: &SpaceWarp,
         slot: usize,
-        x: DVec3,
+        vertex: MovingVertex<DVec3>,
         w: DVec3,
-        u: DVec3,
-        spin: DVec3,
         velocity: impl Fn(DVec3, u32) -> DVec3,
     ) -> (DVec3, f64) {
-        self.fibre_velocity(warp, slot, x, w, u, spin, velocity)
+        self.fibre_velocity(warp, slot, vertex, w, velocity)
     }
 }
 

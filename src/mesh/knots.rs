@@ -9,46 +9,44 @@
 //! dimensions", section "A warp on the sphere".
 use super::edges::Edge;
 use super::space::Space;
-use super::warp::{Crossing, FibreKnot};
+use super::warp::{Crossing, Fibre, FibreKnot};
 use crate::path::NO_PRIM;
 use glam::DVec3;
 
 impl Space {
     /// The visible edge crossings of the fibre nearest to θ on either side,
-    /// within the knots `lo` and `hi` already found. At the sensor's point
+    /// within the knots `lo` and `hi` already found, seen from the fibre's
+    /// vertex, which lies on the primitive `skip`. At the sensor's point
     /// the search runs in the sensor's own edge tree, and where the visible
     /// parts of the edges are known
     /// ([`SensorView`](super::sensor_view::SensorView)) needs no shadow ray.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn nearest_crossings(
         &self,
-        x: DVec3,
+        fibre: &Fibre,
         skip: u32,
-        p: DVec3,
-        u: DVec3,
-        m: DVec3,
-        cos_theta: f64,
         lo: FibreKnot,
         hi: FibreKnot,
     ) -> (FibreKnot, FibreKnot) {
-        let at_sensor = skip == NO_PRIM && self.sensor_view().point == x;
-        self.nearest_crossings_by(at_sensor, x, skip, p, u, m, cos_theta, lo, hi)
+        let at_sensor = skip == NO_PRIM && self.sensor_view().point == fibre.x;
+        self.nearest_crossings_by(at_sensor, fibre, skip, lo, hi)
     }
 
     /// [`Self::nearest_crossings`], by the sensor's view or by shadow rays.
-    #[allow(clippy::too_many_arguments)]
     fn nearest_crossings_by(
         &self,
         at_sensor: bool,
-        x: DVec3,
+        fibre: &Fibre,
         skip: u32,
-        p: DVec3,
-        u: DVec3,
-        m: DVec3,
-        cos_theta: f64,
         mut lo: FibreKnot,
         mut hi: FibreKnot,
     ) -> (FibreKnot, FibreKnot) {
+        let Fibre {
+            x,
+            p,
+            u,
+            m,
+            cos_theta,
+        } = *fibre;
         let tables = self.edge_tables();
         let edges = &tables.edges;
         let (tree, list, visible) = if at_sensor {
@@ -69,12 +67,12 @@ impl Space {
                 Some(list) => {
                     for &i in list {
                         let e = &edges[i as usize];
-                        nearer_seen(e, i, x, p, u, m, cos_theta, visible, &mut lo, &mut hi);
+                        nearer_seen(e, i, fibre, visible, &mut lo, &mut hi);
                     }
                 }
                 None => tree.crossings(x, m, u, edges, &tables.edge_facts, |i| {
                     let e = &edges[i as usize];
-                    nearer_seen(e, i, x, p, u, m, cos_theta, visible, &mut lo, &mut hi);
+                    nearer_seen(e, i, fibre, visible, &mut lo, &mut hi);
                 }),
             }
             return (lo, hi);
@@ -90,7 +88,7 @@ impl Space {
             let (mut near_lo, mut near_hi) = (Nearest::new(), Nearest::new());
             let mut candidate = |i: u32| {
                 let e = &edges[i as usize];
-                let Some((cos, _, q)) = cut(e, x, p, u, m) else {
+                let Some((cos, _, q)) = cut(e, fibre) else {
                     return;
                 };
                 let knot = crossing_knot(e, cos, q);
@@ -141,11 +139,12 @@ impl Space {
     }
 }
 
-/// Where the plane through `x` of normal `m` crosses the edge `e` on the
-/// fibre's side (`u`): the cosine of its polar angle from `p`, the edge
-/// parameter and the point.
+/// Where the fibre's plane (through `x`, of normal `m`) crosses the edge
+/// `e` on the fibre's side (`u`): the cosine of its polar angle from `p`,
+/// the edge parameter and the point.
 #[inline(always)]
-fn cut(e: &Edge, x: DVec3, p: DVec3, u: DVec3, m: DVec3) -> Option<(f64, f64, DVec3)> {
+fn cut(e: &Edge, fibre: &Fibre) -> Option<(f64, f64, DVec3)> {
+    let Fibre { x, p, u, m, .. } = *fibre;
     let (sa, sb) = ((e.a - x).dot(m), (e.b - x).dot(m));
     if (sa > 0.0 && sb > 0.0) || (sa < 0.0 && sb < 0.0) || sa == sb {
         return None;
@@ -177,20 +176,16 @@ fn crossing_knot(e: &Edge, cos: f64, q: DVec3) -> FibreKnot {
 /// One edge's crossing, if seen, as the nearer of it and the knots found
 /// so far on its side.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn nearer_seen(
     e: &Edge,
     i: u32,
-    x: DVec3,
-    p: DVec3,
-    u: DVec3,
-    m: DVec3,
-    cos_theta: f64,
+    fibre: &Fibre,
     visible: &super::sensor_view::Visible,
     lo: &mut FibreKnot,
     hi: &mut FibreKnot,
 ) {
-    let Some((cos, t, q)) = cut(e, x, p, u, m) else {
+    let cos_theta = fibre.cos_theta;
+    let Some((cos, t, q)) = cut(e, fibre) else {
         return;
     };
     if cos > cos_theta && cos < lo.cos && visible.sees(i, t) {
@@ -318,10 +313,17 @@ mod tests {
             let perp = w - p * c;
             let u = perp / perp.length();
             let m = p.cross(u);
+            let fibre = Fibre {
+                x,
+                p,
+                u,
+                m,
+                cos_theta: c,
+            };
             let by_view =
-                space.nearest_crossings_by(true, x, NO_PRIM, p, u, m, c, still(1.0), still(-1.0));
+                space.nearest_crossings_by(true, &fibre, NO_PRIM, still(1.0), still(-1.0));
             let by_rays =
-                space.nearest_crossings_by(false, x, NO_PRIM, p, u, m, c, still(1.0), still(-1.0));
+                space.nearest_crossings_by(false, &fibre, NO_PRIM, still(1.0), still(-1.0));
             // The same knot, or (at a mesh corner, where two edges cross
             // the plane a rounding apart) one as near.
             for (a, b) in [(by_view.0, by_rays.0), (by_view.1, by_rays.1)] {
@@ -343,7 +345,7 @@ mod tests {
             let nearest_any = space
                 .edges()
                 .iter()
-                .filter_map(|e| cut(e, x, p, u, m))
+                .filter_map(|e| cut(e, &fibre))
                 .filter(|&(cos, _, _)| cos > c)
                 .map(|(cos, _, _)| cos)
                 .fold(f64::INFINITY, f64::min);

@@ -14,7 +14,9 @@ use super::scene::{Scene, Sensor as SceneSensor};
 use super::sensor_view::SensorView;
 use crate::path::deform::SlotSet;
 use crate::path::thin_media::chord_bound;
-use crate::path::{Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface};
+use crate::path::{
+    Coefficients, Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface,
+};
 use crate::rng::PathRng;
 use glam::DVec3;
 use rand::RngExt;
@@ -524,8 +526,10 @@ impl Geometry for Space {
         self.scene.is_solid(self.owner[p as usize])
     }
     #[inline]
-    fn coefficients(&self, m: MediumId) -> Option<(f64, f64)> {
-        self.scene.medium(m).map(|m| (m.ks, m.ke))
+    fn coefficients(&self, m: MediumId) -> Option<Coefficients> {
+        self.scene
+            .medium(m)
+            .map(|m| Coefficients { ks: m.ks, ke: m.ke })
     }
     #[inline]
     fn medium_chord(&self, m: MediumId) -> f64 {

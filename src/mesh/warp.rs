@@ -34,9 +34,28 @@
 use super::lobe::SpaceLobe;
 use super::poles::{MAX_FIELDS, pole};
 use super::space::{Space, Sphere};
+use crate::path::MovingVertex;
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
 use glam::DVec3;
+
+/// A fibre of the warp at the vertex `x`: the half great circle of
+/// directions from the pole `p` through the sampled direction η, in the
+/// plane of unit normal `m = p × u`, `u` the unit vector of that plane
+/// normal to `p` on η's side. What its knot search needs.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Fibre {
+    /// The vertex.
+    pub(super) x: DVec3,
+    /// The pole.
+    pub(super) p: DVec3,
+    /// The unit vector normal to the pole in the fibre's plane, toward η.
+    pub(super) u: DVec3,
+    /// The plane's unit normal `p × u`.
+    pub(super) m: DVec3,
+    /// The cosine of η's polar angle θ from the pole.
+    pub(super) cos_theta: f64,
+}
 
 /// A knot of a fibre: its polar angle (and cosine) and, for an edge
 /// crossing, the crossing.
@@ -240,7 +259,14 @@ impl Space {
                 }
             }
         }
-        let (lo, hi) = self.nearest_crossings(x, v.skip, p, u, m, c, lo, hi);
+        let fibre = Fibre {
+            x,
+            p,
+            u,
+            m,
+            cos_theta: c,
+        };
+        let (lo, hi) = self.nearest_crossings(&fibre, v.skip, lo, hi);
         // What the slots' rates need at the chosen crossings.
         let finish = |k: FibreKnot| -> FibreKnot {
             let Some(e) = k.edge else { return k };
@@ -274,18 +300,17 @@ impl Space {
     // ANCHOR_END: fibre_warp
 
     // ANCHOR: fibre_velocity
-    /// One slot's direction velocity and divergence under the warp.
-    #[allow(clippy::too_many_arguments)]
+    /// One slot's direction velocity and divergence under the warp, the
+    /// vertex as the slot moves it.
     pub(super) fn fibre_velocity(
         &self,
         warp: &SpaceWarp,
         slot: usize,
-        x: DVec3,
+        vertex: MovingVertex<DVec3>,
         w: DVec3,
-        u: DVec3,
-        spin: DVec3,
         velocity: impl Fn(DVec3, u32) -> DVec3,
     ) -> (DVec3, f64) {
+        let MovingVertex { x, u, spin } = vertex;
         let rigid = spin.cross(w);
         let field = self.slot_field.get(slot).copied().unwrap_or(0) as usize;
         let warp = &warp.fields[field.min(warp.count.saturating_sub(1))];
@@ -418,9 +443,12 @@ mod tests {
                             DVec3::ZERO
                         }
                     };
-                    let f = |warp| {
-                        space.fibre_velocity(&warp, j, x, w, DVec3::ZERO, DVec3::ZERO, velocity)
+                    let still = MovingVertex {
+                        x,
+                        u: DVec3::ZERO,
+                        spin: DVec3::ZERO,
                     };
+                    let f = |warp| space.fibre_velocity(&warp, j, still, w, velocity);
                     let (a, b) = (f(quiet), f(searched));
                     assert_eq!(a, b, "slot {j} at {x} along {w}");
                     let field = space.slot_field[j] as usize;

@@ -13,7 +13,7 @@
 use super::nested::Scratch;
 use super::rendering::Rendering;
 use super::walk::{Vertex, light_sample, transmittance_by};
-use super::{Boundaries, Geometry, Hit, Vector};
+use super::{Boundaries, Geometry, Hit, Prim, Vector};
 use crate::estimator::within_rounding;
 use crate::rng::PathRng;
 
@@ -274,32 +274,6 @@ impl<V: Vector> Deform<V> {
     }
     // ANCHOR_END: boundary_speed
 
-    /// [`Deform::boundary_speed`] for the segment from `x` along `w` ending
-    /// at `hit` (slots moving the hit shape per `slots`, none when
-    /// `frozen`); every `ṫ_b` is 0 when the segment escapes.
-    #[inline]
-    pub fn segment<G: Geometry<V = V>>(
-        &mut self,
-        g: &G,
-        slots: &Slots,
-        frozen: bool,
-        x: V,
-        w: V,
-        hit: Option<Hit>,
-    ) {
-        match hit {
-            Some(h) => {
-                let moving = if frozen {
-                    SlotSet::EMPTY
-                } else {
-                    slots.moving(g.shape(h.prim))
-                };
-                self.boundary_speed(g, h, x, w, moving);
-            }
-            None => self.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
-        }
-    }
-
     /// A fixed free path `ξ`: every live slot's vertex moves with its
     /// turning direction only, `u += ξ η̇`.
     #[inline]
@@ -455,68 +429,121 @@ impl Slots {
     }
 }
 
+/// Whether a derivative walk's shapes move with their parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SceneMotion {
+    /// They do: a path's own walk.
+    Moving,
+    /// They stand still, and only the velocities the walk starts with are
+    /// differentiated: transport's frozen walks, which estimate a gradient
+    /// of the radiance.
+    Frozen,
+}
+
+/// A derivative walk's state, which each method's hooks hold: what it
+/// differentiates and whether its scene moves, its deformation, and the
+/// states and work its connections and nested walks take. The terms the
+/// methods share (connections, rendering's Leibniz and corner terms) are
+/// its methods.
+pub struct DerivativeWalk<'a, G: Geometry> {
+    /// What is differentiated.
+    pub slots: &'a Slots,
+    /// Whether the shapes move.
+    pub scene: SceneMotion,
+    /// States for connections and nested walks, and the path's work.
+    pub scratch: &'a mut Scratch<G::V>,
+    /// The walk's deformation.
+    pub d: Deform<G::V>,
+}
+
+impl<G: Geometry> DerivativeWalk<'_, G> {
+    /// The slots whose material points move on shape `k` (none in a frozen
+    /// scene).
+    #[inline]
+    pub fn movers(&self, k: u32) -> SlotSet {
+        match self.scene {
+            SceneMotion::Moving => self.slots.moving(k),
+            SceneMotion::Frozen => SlotSet::EMPTY,
+        }
+    }
+
+    /// [`Deform::boundary_speed`] for the segment from `x` along `w` ending
+    /// at `hit`, the hit shape moving for its [`movers`](Self::movers);
+    /// every `ṫ_b` is 0 when the segment escapes.
+    #[inline]
+    pub fn segment(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
+        match hit {
+            Some(h) => {
+                let moving = self.movers(g.shape(h.prim));
+                self.d.boundary_speed(g, h, x, w, moving);
+            }
+            None => self.d.slots.iter_mut().for_each(|s| s.tb_dot = 0.0),
+        }
+    }
+}
+
 // ANCHOR: connect
-/// Next-event estimation at `v` for a derivative walk in state `d`: one
-/// emitter point drawn as the intensity estimator draws it; its direction
-/// `η` deforms as `direction` sets it (the method's rule: the frame's turn,
-/// the warp), the connection's segments follow, and `contribution × score`
-/// is added to every slot. The connection's segments are followed by
-/// rendering's hooks (it has no free path, so only their boundary speed,
-/// transmittance and vertex carrying act). The MIS weight is a fixed partition of unity in
-/// the method's own coordinates over directions, so it is not
-/// differentiated (book: "Next-event estimation in the derivative walks").
-/// With `precheck`, a blocked connection is found by a plain shadow walk
-/// before `direction` runs (worth it when `direction` costs more than the
-/// extra ray: the expectation method's warp); its hits are kept, handed to
-/// `direction` (the first: `Some(hit)`) and replayed to the hooks, so no
-/// ray is cast twice and the result is the same.
-#[allow(clippy::too_many_arguments)]
-pub fn connect<G: Boundaries>(
-    g: &G,
-    slots: &Slots,
-    scratch: &mut Scratch<G::V>,
-    d: &mut Deform<G::V>,
-    rng: &mut PathRng,
-    v: &Vertex<G>,
-    frozen: bool,
-    precheck: bool,
-    direction: impl FnOnce(&mut Deform<G::V>, G::V, Option<Option<Hit>>),
-) -> f64 {
-    let Some((w, p, c)) = light_sample(g, rng, v) else {
-        return 0.0;
-    };
-    // A blocked connection adds nothing, whatever its direction's
-    // velocity: a direction rule that costs more than a shadow ray (the
-    // expectation method's warp) is worth skipping there.
-    let mut record = Recorded::default();
-    if precheck {
-        let cast = |x, w, skip| record.cast(g, x, w, skip);
-        if transmittance_by(g, &mut (), v.x, w, v.medium, v.skip, p, cast) == 0.0 {
+impl<G: Boundaries> DerivativeWalk<'_, G> {
+    /// Next-event estimation at `v`: one emitter point drawn as the
+    /// intensity estimator draws it; its direction `η` deforms as
+    /// `direction` sets it in a copy of the walk (the method's rule: the
+    /// frame's turn, the warp), the connection's segments follow, and
+    /// `contribution × score` is added to every slot. The connection's
+    /// segments are followed by rendering's hooks (it has no free path, so
+    /// only their boundary speed, transmittance and vertex carrying act).
+    /// The MIS weight is a fixed partition of unity in the method's own
+    /// coordinates over directions, so it is not differentiated (book:
+    /// "Next-event estimation in the derivative walks"). With `precheck`, a
+    /// blocked connection is found by a plain shadow walk before
+    /// `direction` runs (worth it when `direction` costs more than the
+    /// extra ray: the expectation method's warp); its hits are kept, handed
+    /// to `direction` (the first: `Some(hit)`) and replayed to the hooks,
+    /// so no ray is cast twice and the result is the same.
+    pub fn connect(
+        &mut self,
+        g: &G,
+        rng: &mut PathRng,
+        v: &Vertex<G>,
+        precheck: bool,
+        direction: impl FnOnce(&mut DerivativeWalk<'_, G>, G::V, Option<Option<Hit>>),
+    ) -> f64 {
+        let Some((w, p, c)) = light_sample(g, rng, v) else {
             return 0.0;
+        };
+        // A blocked connection adds nothing, whatever its direction's
+        // velocity: a direction rule that costs more than a shadow ray (the
+        // expectation method's warp) is worth skipping there.
+        let mut record = Recorded::default();
+        if precheck {
+            let cast = |x, w, skip| record.cast(g, x, w, skip);
+            if transmittance_by(g, &mut (), v.ray(w), p, cast) == 0.0 {
+                return 0.0;
+            }
         }
-    }
-    let mut tmp = scratch.take_copy(d);
-    direction(&mut tmp, w, precheck.then(|| record.first()));
-    let mut follow = Rendering {
-        slots,
-        scratch,
-        d: tmp,
-        frozen,
-    };
-    let mut replay = 0;
-    let cast = |x, w, skip| record.replay(&mut replay, g, x, w, skip);
-    let contribution = c * transmittance_by(g, &mut follow, v.x, w, v.medium, v.skip, p, cast);
-    let Rendering {
-        d: tmp, scratch, ..
-    } = follow;
-    if contribution != 0.0 {
-        for j in tmp.live.iter() {
-            let t = &tmp.slots[j];
-            d.slots[j].add_boundary(contribution * t.score, (contribution * t.score_scale).abs());
+        let d = self.scratch.take_copy(&self.d);
+        let mut follow = Rendering {
+            walk: DerivativeWalk {
+                slots: self.slots,
+                scene: self.scene,
+                scratch: &mut *self.scratch,
+                d,
+            },
+        };
+        direction(&mut follow.walk, w, precheck.then(|| record.first()));
+        let mut replay = 0;
+        let cast = |x, w, skip| record.replay(&mut replay, g, x, w, skip);
+        let contribution = c * transmittance_by(g, &mut follow, v.ray(w), p, cast);
+        let tmp = follow.walk.d;
+        if contribution != 0.0 {
+            for j in tmp.live.iter() {
+                let t = &tmp.slots[j];
+                let scale = (contribution * t.score_scale).abs();
+                self.d.slots[j].add_boundary(contribution * t.score, scale);
+            }
         }
+        self.scratch.give(tmp);
+        contribution
     }
-    scratch.give(tmp);
-    contribution
 }
 
 /// The hits of a connection's shadow walk, kept for its replay (a few: a
@@ -530,7 +557,7 @@ struct Recorded {
 impl Recorded {
     /// Casts and keeps the hit.
     #[inline]
-    fn cast<G: Geometry>(&mut self, g: &G, x: G::V, w: G::V, skip: super::Prim) -> Option<Hit> {
+    fn cast<G: Geometry>(&mut self, g: &G, x: G::V, w: G::V, skip: Prim) -> Option<Hit> {
         let h = g.cast(x, w, skip);
         if self.n < self.hits.len() {
             self.hits[self.n] = h;
@@ -548,7 +575,7 @@ impl Recorded {
         g: &G,
         x: G::V,
         w: G::V,
-        skip: super::Prim,
+        skip: Prim,
     ) -> Option<Hit> {
         let k = *i;
         *i += 1;

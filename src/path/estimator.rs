@@ -4,12 +4,12 @@
 //! declaration order, then (transport) the sensor position's gradient.
 //! States are reused across the paths of a chunk: the hot loop allocates
 //! nothing per path.
-use super::deform::Slots;
+use super::deform::{DerivativeWalk, SceneMotion, Slots};
 use super::expectation::Expectation;
 use super::nested::{Budget, Scratch, Work};
 use super::rendering::Rendering;
 use super::transport::Transport;
-use super::walk::{Frame, Hooks, Vertex, walk};
+use super::walk::{Drawn, Frame, Hooks, Ray, Vertex, walk};
 use super::{Boundaries, Geometry, Lobe, NO_PRIM, PixelSample, Sensor, Vector};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
@@ -26,6 +26,13 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
     pixel: PixelSample,
 ) -> (f64, f64) {
     let medium = g.sensor_medium();
+    // The sensor's rays start from its point, in its medium.
+    let ray = |x: G::V, w: G::V| Ray {
+        x,
+        w,
+        medium,
+        skip: NO_PRIM,
+    };
     match g.sensor() {
         Sensor::Camera { point } => {
             let Some(lobe) = g.pixel_lobe(pixel) else {
@@ -50,15 +57,11 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
             };
             let w = hooks.scatter(g, rng, &v);
             let scale = lobe.weight();
-            (
-                scale * walk(g, hooks, rng, point, w, medium, NO_PRIM, 1.0, None),
-                scale,
-            )
+            (scale * walk(g, hooks, rng, ray(point, w), 1.0, None), scale)
         }
-        Sensor::Radiance { point, direction } => (
-            walk(g, hooks, rng, point, direction, medium, NO_PRIM, 1.0, None),
-            1.0,
-        ),
+        Sensor::Radiance { point, direction } => {
+            (walk(g, hooks, rng, ray(point, direction), 1.0, None), 1.0)
+        }
         Sensor::Irradiance { point, normal } => {
             let lobe = g.cosine_lobe(normal, 1.0);
             // The walk carries the lobe's weight outside, so Russian
@@ -89,10 +92,13 @@ pub fn reading<G: Geometry, H: Hooks<G>>(
             } else {
                 (lobe.pdf(w), 1.0)
             };
-            let drawn = H::NEXT_EVENT.then_some((q, point));
+            let drawn = H::NEXT_EVENT.then_some(Drawn {
+                pdf: q,
+                from: point,
+            });
             let scale = lobe.weight();
             (
-                scale * (direct + walk(g, hooks, rng, point, w, medium, NO_PRIM, beta, drawn)),
+                scale * (direct + walk(g, hooks, rng, ray(point, w), beta, drawn)),
                 scale,
             )
         }
@@ -143,27 +149,26 @@ impl<G: Boundaries> DerivativeEstimator<G> {
         scratch.work = Work::new(self.budget);
         let mut d = scratch.take(slots.len());
         slots.start(&mut d);
+        let walk = DerivativeWalk {
+            slots,
+            scene: SceneMotion::Moving,
+            scratch,
+            d,
+        };
         let ((i, scale), d) = match self.scheme {
             Scheme::Rendering => {
-                let mut h = Rendering {
-                    slots,
-                    scratch,
-                    d,
-                    frozen: false,
-                };
-                (reading(g, &mut h, rng, pixel), h.d)
+                let mut h = Rendering { walk };
+                (reading(g, &mut h, rng, pixel), h.walk.d)
             }
             Scheme::Expectation => {
                 let mut h = Expectation {
-                    slots,
-                    scratch,
-                    d,
+                    walk,
                     pending: None,
                 };
-                (reading(g, &mut h, rng, pixel), h.d)
+                (reading(g, &mut h, rng, pixel), h.walk.d)
             }
             Scheme::Transport => {
-                let mut h = Transport::new(slots, scratch, d);
+                let mut h = Transport::new(walk);
                 (reading(g, &mut h, rng, pixel), h.finish())
             }
         };

@@ -15,58 +15,55 @@
 //!
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Expectation" and "The warp field".
-use super::deform::{Deform, Slots, connect};
-use super::nested::Scratch;
-use super::rendering::frame_spins;
+use super::deform::DerivativeWalk;
 use super::walk::{Hooks, Vertex};
-use super::{Boundaries, Geometry, Hit, Lobe, Vector};
+use super::{Boundaries, Geometry, Hit, Lobe, MovingVertex, Vector};
 use crate::rng::PathRng;
 
-/// The expectation method's hooks: one walk's deformation state.
+/// The expectation method's hooks: one walk's state (its scene moves; its
+/// scratch serves connections only).
 pub struct Expectation<'a, G: Geometry> {
-    /// What is differentiated.
-    pub slots: &'a Slots,
-    /// States for connections.
-    pub scratch: &'a mut Scratch<G::V>,
     /// The walk's state.
-    pub d: Deform<G::V>,
+    pub walk: DerivativeWalk<'a, G>,
     /// A direction drawn in vacuum whose warp waits for its ray's hit: a
     /// path that then ends without light skips it (see `dead_end`).
     pub pending: Option<(Vertex<G>, G::V)>,
 }
 
 // ANCHOR: warp
-/// Moves the direction `w` drawn at `v` with the warp: every slot's `η̇`,
-/// and the warp's divergence plus `∂ ln f` along it added to its score.
-#[inline]
-fn warp<G: Boundaries>(
-    g: &G,
-    slots: &Slots,
-    d: &mut Deform<G::V>,
-    v: &Vertex<G>,
-    w: G::V,
-    ahead: Option<Option<Hit>>,
-) {
-    let turning = frame_spins(g, slots, d, v, false);
-    let mut involved = d.live.union(turning);
-    let field = g.warp(v, w, ahead, involved);
-    g.warp_shapes(&field, |k| involved = involved.union(slots.moving(k)));
-    for j in involved.iter() {
-        let s = &mut d.slots[j];
-        let velocity = |q: G::V, k: u32| {
-            if j < slots.params && g.parameter_shape(j) == k {
-                g.velocity(j, q)
-            } else {
-                G::V::ZERO
-            }
-        };
-        let (wd, div) = g.warp_velocity(&field, j, v.x, w, s.u, s.spin, velocity);
-        s.add_score(div);
-        s.add_score(v.lobe.dlog(w, wd - G::V::turn(s.spin, w)));
-        s.wd = wd;
-    }
-    for j in involved.iter() {
-        d.touch(j);
+impl<G: Boundaries> DerivativeWalk<'_, G> {
+    /// Moves the direction `w` drawn at `v` with the warp: every slot's
+    /// `η̇`, and the warp's divergence plus `∂ ln f` along it added to its
+    /// score.
+    #[inline]
+    fn warp(&mut self, g: &G, v: &Vertex<G>, w: G::V, ahead: Option<Option<Hit>>) {
+        let turning = self.frame_spins(g, v);
+        let (slots, d) = (self.slots, &mut self.d);
+        let mut involved = d.live.union(turning);
+        let field = g.warp(v, w, ahead, involved);
+        g.warp_shapes(&field, |k| involved = involved.union(slots.moving(k)));
+        for j in involved.iter() {
+            let s = &mut d.slots[j];
+            let velocity = |q: G::V, k: u32| {
+                if j < slots.params && g.parameter_shape(j) == k {
+                    g.velocity(j, q)
+                } else {
+                    G::V::ZERO
+                }
+            };
+            let vertex = MovingVertex {
+                x: v.x,
+                u: s.u,
+                spin: s.spin,
+            };
+            let (wd, div) = g.warp_velocity(&field, j, vertex, w, velocity);
+            s.add_score(div);
+            s.add_score(v.lobe.dlog(w, wd - G::V::turn(s.spin, w)));
+            s.wd = wd;
+        }
+        for j in involved.iter() {
+            d.touch(j);
+        }
     }
 }
 // ANCHOR_END: warp
@@ -91,17 +88,18 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
         if let Some((v, drawn)) = self.pending.take() {
             debug_assert!(drawn == w, "the pending direction is the ray's");
             if !dead_end(g, hit) {
-                warp(g, self.slots, &mut self.d, &v, w, Some(hit));
+                self.walk.warp(g, &v, w, Some(hit));
             }
         }
-        self.d.segment(g, self.slots, false, x, w, hit);
+        self.walk.segment(g, x, w, hit);
     }
     // ANCHOR: collision
     #[inline]
     fn collision(&mut self, w: G::V, xi: f64, t_b: f64, ke: f64) {
         // The free path stretches with its domain [0, t_b].
-        for j in self.d.live.iter() {
-            let s = &mut self.d.slots[j];
+        let d = &mut self.walk.d;
+        for j in d.live.iter() {
+            let s = &mut d.slots[j];
             s.add_score(s.tb_dot / t_b);
             let xi_dot = xi / t_b * s.tb_dot;
             s.add_score(-ke * xi_dot);
@@ -111,35 +109,25 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     // ANCHOR_END: collision
     #[inline]
     fn pass(&mut self, ke: f64) {
-        self.d.pass(self.slots.all(), ke);
+        self.walk.d.pass(self.walk.slots.all(), ke);
     }
     #[inline]
     fn arrive(&mut self, w: G::V, t: f64) {
-        self.d.arrive(self.slots.all(), w, t);
+        self.walk.d.arrive(self.walk.slots.all(), w, t);
     }
     #[inline]
     fn emission(&mut self, contribution: f64) {
-        self.d.collect(contribution);
+        self.walk.d.collect(contribution);
     }
     #[inline]
     fn visit(&mut self, _x: G::V) {
         // Counted for the path's work (no nested walk here).
-        self.scratch.work.main += 1;
+        self.walk.scratch.work.main += 1;
     }
     #[inline]
     fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
-        let slots = self.slots;
-        connect(
-            g,
-            slots,
-            self.scratch,
-            &mut self.d,
-            rng,
-            v,
-            false,
-            true,
-            |d, w, ahead| warp(g, slots, d, v, w, ahead),
-        )
+        self.walk
+            .connect(g, rng, v, true, |walk, w, ahead| walk.warp(g, v, w, ahead))
     }
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
@@ -148,9 +136,9 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
         } else {
             v.lobe.sample(rng)
         };
-        if !self.slots.is_empty() {
+        if !self.walk.slots.is_empty() {
             if g.coefficients(v.medium).is_some() {
-                warp(g, self.slots, &mut self.d, v, w, None);
+                self.walk.warp(g, v, w, None);
             } else {
                 self.pending = Some((*v, w));
             }

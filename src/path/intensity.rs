@@ -3,8 +3,8 @@
 //! [`Observed`] records the path's vertices for figures. Book: chapter
 //! "Flatland", section "Backward path tracing".
 use super::estimator::reading;
-use super::walk::Hooks;
-use super::{Geometry, MediumId, PixelSample, Prim};
+use super::walk::{Hooks, Ray};
+use super::{Geometry, PixelSample};
 use crate::estimator::{Estimator, Quantity};
 use crate::rng::PathRng;
 
@@ -72,17 +72,14 @@ impl<G: Geometry, F: FnMut(G::V)> Hooks<G> for Observed<F> {
     }
 }
 
-/// The radiance arriving at `x` from direction `w` (the path travels along
-/// `w`) by one path, calling `vertex` at every scattering, reflection or
-/// crossing point and at the end of the path.
+/// The radiance arriving at the ray's origin from its direction (the path
+/// travels along it) by one path, calling `vertex` at every scattering,
+/// reflection or crossing point and at the end of the path.
 pub fn radiance_observed<G: Geometry>(
     g: &G,
     rng: &mut PathRng,
-    x: G::V,
-    w: G::V,
-    medium: MediumId,
-    skip: Prim,
+    ray: Ray<G::V>,
     vertex: impl FnMut(G::V),
 ) -> f64 {
-    super::walk::walk(g, &mut Observed(vertex), rng, x, w, medium, skip, 1.0, None)
+    super::walk::walk(g, &mut Observed(vertex), rng, ray, 1.0, None)
 }

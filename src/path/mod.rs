@@ -207,6 +207,15 @@ pub const NO_PRIM: Prim = u32::MAX;
 /// A medium: the index of the shape that holds it, `None` for vacuum.
 pub type MediumId = Option<u32>;
 
+/// The coefficients of a homogeneous medium.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coefficients {
+    /// Scattering coefficient κs.
+    pub ks: f64,
+    /// Extinction coefficient κe ≥ κs.
+    pub ke: f64,
+}
+
 /// A closest hit along a unit ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {
@@ -291,8 +300,8 @@ pub trait Geometry: Sync {
     fn solid(&self, _p: Prim) -> bool {
         false
     }
-    /// `(κs, κe)` of a medium.
-    fn coefficients(&self, m: MediumId) -> Option<(f64, f64)>;
+    /// The coefficients of medium `m` (`None`: vacuum).
+    fn coefficients(&self, m: MediumId) -> Option<Coefficients>;
     /// An upper bound on the length of a straight path inside medium `m`
     /// ([`thin_media::chord_bound`] of its boundary's vertices): in an
     /// optically thin medium the walk draws collisions as if it were
@@ -352,6 +361,19 @@ pub struct BoundaryPoint<V> {
     pub index: u32,
     /// The inverse of its selection probability.
     pub inv_pdf: f64,
+}
+
+/// A scattering vertex as one slot moves it: its position `x`, its
+/// velocity `u` and the turn rate `spin` of the frame its directions are
+/// attached to. A warp's knots move relative to it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MovingVertex<V: Vector> {
+    /// Position.
+    pub x: V,
+    /// Velocity `u_j`.
+    pub u: V,
+    /// The frame's turn rate `Ω_j`.
+    pub spin: V::Spin,
 }
 
 /// What a ray just to one side of a boundary point sees there.
@@ -482,19 +504,16 @@ pub trait Boundaries: Geometry {
     /// Calls `f` with every shape whose motion the warp at `w` follows.
     fn warp_shapes(&self, warp: &Self::Warp, f: impl FnMut(u32));
     /// Slot `slot`'s velocity of the direction `w` under the warp, and the
-    /// warp's divergence there: `u` is the vertex velocity, `spin` the
-    /// frame's turn rate, `velocity(q, k)` the velocity of point `q` of
-    /// shape `k`. (A geometry may build a different field per slot: 3D
-    /// aligns its fibres with each parameter's motion.)
-    #[allow(clippy::too_many_arguments)]
+    /// warp's divergence there: `vertex` is the vertex as the slot moves it,
+    /// `velocity(q, k)` the velocity of point `q` of shape `k`. (A geometry
+    /// may build a different field per slot: 3D aligns its fibres with each
+    /// parameter's motion.)
     fn warp_velocity(
         &self,
         warp: &Self::Warp,
         slot: usize,
-        x: Self::V,
+        vertex: MovingVertex<Self::V>,
         w: Self::V,
-        u: Self::V,
-        spin: <Self::V as Vector>::Spin,
         velocity: impl Fn(Self::V, u32) -> Self::V,
     ) -> (Self::V, f64);
 }

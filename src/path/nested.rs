@@ -42,7 +42,7 @@
 //! Book: chapter "When not to trust a number", section "Runs that end".
 use super::deform::Deform;
 use super::walk::{
-    Frame, Hooks, Vertex, behind_solid, next_event, reflector_lobe, transmittance, walk,
+    Drawn, Frame, Hooks, Ray, Vertex, behind_solid, next_event, reflector_lobe, transmittance, walk,
 };
 use super::{Geometry, Lobe, MediumId, Prim, Surface, Vector, mis};
 use crate::rng::PathRng;
@@ -249,18 +249,27 @@ impl<V: Vector> Scratch<V> {
     }
 }
 
-/// The radiance leaving the surface of primitive `p` at its point `y`
-/// toward a viewer arriving along `w` (in `medium`): one path continued
-/// from that surface event. A corner's jump evaluates each side with it.
+/// A point `y` of primitive `prim`'s surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint<V> {
+    /// The point.
+    pub y: V,
+    /// The primitive.
+    pub prim: Prim,
+}
+
+/// The radiance leaving the surface at `at` toward a viewer arriving along
+/// `w` (in `medium`): one path continued from that surface event. A
+/// corner's jump evaluates each side with it.
 pub fn surface_radiance<G: Geometry>(
     g: &G,
     work: &mut Work,
     rng: &mut PathRng,
-    y: G::V,
-    p: Prim,
+    at: SurfacePoint<G::V>,
     w: G::V,
     medium: MediumId,
 ) -> f64 {
+    let SurfacePoint { y, prim: p } = at;
     match g.surface(p) {
         Surface::Emitter { radiance } => radiance,
         Surface::Absorber | Surface::Transparent => 0.0,
@@ -280,8 +289,11 @@ pub fn surface_radiance<G: Geometry>(
             };
             let direct = next_event(g, rng, &v);
             let wo = lobe.sample(rng);
-            let drawn = Some((lobe.pdf(wo), y));
-            direct + walk(g, work, rng, y, wo, medium, p, v.beta, drawn)
+            let drawn = Drawn {
+                pdf: lobe.pdf(wo),
+                from: y,
+            };
+            direct + walk(g, work, rng, v.ray(wo), v.beta, Some(drawn))
         }
     }
 }
@@ -289,8 +301,8 @@ pub fn surface_radiance<G: Geometry>(
 // ANCHOR: reflected_jump
 /// The jump `L_b − L_a` of the radiance leaving a corner (2D) or crease
 /// (3D) of a reflector toward a viewer arriving along `w` (in `medium`),
-/// between its two faces: primitive `pa` at its point `ya` and `pb` at `yb`,
-/// each a hair from the corner.
+/// between its two faces: the points `a` and `b` of their surfaces, each a
+/// hair from the corner.
 ///
 /// The two reflected radiances share their draws: one emitter point, and one
 /// direction from the mixture `p = (p_a + p_b)/2` of the two cosine lobes,
@@ -307,11 +319,12 @@ pub fn reflected_jump<G: Geometry>(
     g: &G,
     work: &mut Work,
     rng: &mut PathRng,
-    (ya, pa): (G::V, Prim),
-    (yb, pb): (G::V, Prim),
+    a: SurfacePoint<G::V>,
+    b: SurfacePoint<G::V>,
     w: G::V,
     medium: MediumId,
 ) -> f64 {
+    let (SurfacePoint { y: ya, prim: pa }, SurfacePoint { y: yb, prim: pb }) = (a, b);
     let (Surface::Reflector { albedo: ra }, Surface::Reflector { albedo: rb }) =
         (g.surface(pa), g.surface(pb))
     else {
@@ -321,7 +334,7 @@ pub fn reflected_jump<G: Geometry>(
     let lb = reflector_lobe(g, pb, yb, w, rb);
     let mixture = |e: G::V| 0.5 * (la.pdf(e) + lb.pdf(e));
     // The side a ray along `e` leaves from: `a` unless only `b` faces `e`.
-    let from = |fa: f64| if fa > 0.0 { (ya, pa) } else { (yb, pb) };
+    let from = |fa: f64| if fa > 0.0 { a } else { b };
     let mut jump = 0.0;
     // The connection: one emitter point for both sides.
     if let Some((y, p)) = g.emitter_point(rng)
@@ -335,9 +348,15 @@ pub fn reflected_jump<G: Geometry>(
         let (fa, fb) = (la.value(ea), lb.value(eb));
         let (pla, plb) = (g.light_pdf(ya, y, p), g.light_pdf(yb, y, p));
         if (fa > 0.0 || fb > 0.0) && pla.is_finite() && plb.is_finite() {
-            let (x, skip) = from(fa);
+            let SurfacePoint { y: x, prim: skip } = from(fa);
             let e = if fa > 0.0 { ea } else { eb };
-            let t = transmittance(g, &mut (), x, e, medium, skip, p);
+            let ray = Ray {
+                x,
+                w: e,
+                medium,
+                skip,
+            };
+            let t = transmittance(g, &mut (), ray, p);
             if t > 0.0 {
                 let side = |f: f64, e: G::V, pl: f64| {
                     if f > 0.0 {
@@ -359,25 +378,23 @@ pub fn reflected_jump<G: Geometry>(
     let p = mixture(e);
     let (fa, fb) = (la.value(e), lb.value(e));
     if p > 0.0 && fa != fb {
-        let (x, skip) = from(fa);
-        let li = walk(g, work, rng, x, e, medium, skip, 1.0, Some((p, x)));
+        let SurfacePoint { y: x, prim: skip } = from(fa);
+        let ray = Ray {
+            x,
+            w: e,
+            medium,
+            skip,
+        };
+        let li = walk(g, work, rng, ray, 1.0, Some(Drawn { pdf: p, from: x }));
         jump += (fb - fa) / p * li;
     }
     jump
 }
 // ANCHOR_END: reflected_jump
 
-/// One-sample estimate of the radiance arriving at `x` from direction `w`
-/// (the path travels along `w`), `x` lying in `medium`, leaving `skip`.
+/// One-sample estimate of the radiance arriving at the ray's origin from
+/// its direction (the path travels along it).
 #[inline]
-pub fn radiance<G: Geometry>(
-    g: &G,
-    work: &mut Work,
-    rng: &mut PathRng,
-    x: G::V,
-    w: G::V,
-    medium: MediumId,
-    skip: Prim,
-) -> f64 {
-    walk(g, work, rng, x, w, medium, skip, 1.0, None)
+pub fn radiance<G: Geometry>(g: &G, work: &mut Work, rng: &mut PathRng, ray: Ray<G::V>) -> f64 {
+    walk(g, work, rng, ray, 1.0, None)
 }

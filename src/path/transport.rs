@@ -5,7 +5,7 @@
 //!
 //! - at an **opaque** moving boundary hit at `y`: `−v·∇L(y⁻, η)`, the
 //!   gradient by a nested walk in the frozen scene started just before `y`
-//!   with velocity `v` ([`Rendering`] with `frozen`);
+//!   with velocity `v` ([`Rendering`] in a [`SceneMotion::Frozen`] scene);
 //! - at a moving **reflector**: the material derivative of the reflected
 //!   radiance: the corner terms seen from the moving point, and its regular
 //!   part by a nested frozen walk from the moving point in the turning frame;
@@ -16,33 +16,29 @@
 //! The sensor-position slots (`∂I/∂x`, …) follow rendering's rules.
 //! Book: chapter "Flatland: one deformation, three estimators", section
 //! "Transport"; in 3D, chapter "Three dimensions", section "Transport in 3D".
-use super::deform::{Deform, Slots};
-use super::nested::{Scratch, radiance};
-use super::rendering::{Rendering, attached_connect, attached_scatter, leibniz};
-use super::walk::{Hooks, Leg, Vertex, walk};
-use super::{Boundaries, Geometry, Hit, MediumId, NO_PRIM, Vector};
+use super::deform::{Deform, DerivativeWalk, SceneMotion};
+use super::nested::radiance;
+use super::rendering::Rendering;
+use super::walk::{Drawn, Hooks, Leg, Ray, Vertex, walk};
+use super::{Boundaries, Coefficients, Geometry, Hit, MediumId, NO_PRIM, Vector};
 use crate::rng::PathRng;
 
-/// The transport method's hooks: one walk's deformation state.
+/// The transport method's hooks: one walk's state, and what it collects at
+/// a moving reflector.
 pub struct Transport<'a, G: Geometry> {
-    /// What is differentiated.
-    pub slots: &'a Slots,
-    /// States for connections and nested walks.
-    pub scratch: &'a mut Scratch<G::V>,
-    /// The walk's state.
-    pub d: Deform<G::V>,
+    /// The walk's state (its scene moves: its shape-parameter slots stay
+    /// fixed in space by the method's own rules).
+    pub walk: DerivativeWalk<'a, G>,
     /// Whether the reflector just reached moves (its material derivative is
     /// being collected).
     moving_reflector: bool,
 }
 
 impl<'a, G: Geometry> Transport<'a, G> {
-    /// Hooks over `d` (zeroed, sensor velocities set).
-    pub fn new(slots: &'a Slots, scratch: &'a mut Scratch<G::V>, d: Deform<G::V>) -> Self {
+    /// Hooks over `walk` (zeroed, sensor velocities set, scene moving).
+    pub fn new(walk: DerivativeWalk<'a, G>) -> Self {
         Transport {
-            slots,
-            scratch,
-            d,
+            walk,
             moving_reflector: false,
         }
     }
@@ -52,10 +48,11 @@ impl<G: Boundaries> Transport<'_, G> {
     /// Whether a shape-parameter slot's boundary moves on this segment.
     #[inline]
     fn euler_moving(&self) -> bool {
-        self.slots
+        let walk = &self.walk;
+        walk.slots
             .parameter_slots
             .iter()
-            .any(|j| self.d.slots[j].tb_dot != 0.0)
+            .any(|j| walk.d.slots[j].tb_dot != 0.0)
     }
 
     // ANCHOR: surface_gradient
@@ -69,25 +66,32 @@ impl<G: Boundaries> Transport<'_, G> {
         leg: &Leg<G>,
         y: G::V,
         k: u32,
-        drawn: Option<(f64, G::V)>,
+        drawn: Option<Drawn<G::V>>,
     ) {
         let Leg { x, w, medium, beta } = *leg;
-        let Some(weight) = self.scratch.work.admit(rng) else {
+        let walk = &mut self.walk;
+        let Some(weight) = walk.scratch.work.admit(rng) else {
             return;
         };
-        let mut nested = self.scratch.take(self.d.len());
-        for j in self.slots.moving(k).iter() {
+        let mut nested = walk.scratch.take(walk.d.len());
+        for j in walk.slots.moving(k).iter() {
             nested.slots[j].u = g.velocity(j, y);
             nested.touch(j);
         }
-        let start = y - w * g.nudge(y).min(0.5 * (y - x).length());
-        let nested = self.frozen_walk(g, rng, nested, start, w, medium, NO_PRIM, drawn);
-        for j in self.slots.parameter_slots.iter() {
+        let start = Ray {
+            x: y - w * g.nudge(y).min(0.5 * (y - x).length()),
+            w,
+            medium,
+            skip: NO_PRIM,
+        };
+        let nested = self.frozen_walk(g, rng, nested, start, drawn);
+        let walk = &mut self.walk;
+        for j in walk.slots.parameter_slots.iter() {
             let n = &nested.slots[j];
             let (b, scale) = (n.boundary * weight, n.boundary_scale * weight);
-            self.d.slots[j].add_boundary(-beta * b, (beta * scale).abs());
+            walk.d.slots[j].add_boundary(-beta * b, (beta * scale).abs());
         }
-        self.scratch.give(nested);
+        walk.scratch.give(nested);
     }
     // ANCHOR_END: surface_gradient
 
@@ -109,22 +113,27 @@ impl<G: Boundaries> Transport<'_, G> {
             return;
         }
         let coefficients = g.coefficients(medium);
+        let walk = &mut self.walk;
         // The in-scattered radiance just before the point, shared by the
         // slots (the nested walk's Leibniz term over its first leg).
         let scattered = match coefficients {
-            Some((ks, _)) if ks > 0.0 => match self.scratch.work.admit(rng) {
+            Some(Coefficients { ks, .. }) if ks > 0.0 => match walk.scratch.work.admit(rng) {
                 Some(weight) => {
-                    let end = v.x - w * (0.5e-9 * g.size());
-                    let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
-                    let work = &mut self.scratch.work;
-                    beta * ks * radiance(g, work, rng, end, wi, medium, NO_PRIM) * weight
+                    let ray = Ray {
+                        x: v.x - w * (0.5e-9 * g.size()),
+                        w: super::Lobe::sample(&g.phase_lobe(medium, w), rng),
+                        medium,
+                        skip: NO_PRIM,
+                    };
+                    let work = &mut walk.scratch.work;
+                    beta * ks * radiance(g, work, rng, ray) * weight
                 }
                 None => 0.0,
             },
             _ => 0.0,
         };
-        let ke = coefficients.map_or(0.0, |c| c.1);
-        for j in self.slots.moving(k).iter() {
+        let ke = coefficients.map_or(0.0, |c| c.ke);
+        for j in walk.slots.moving(k).iter() {
             let vj = g.velocity(j, v.x);
             let along = vj.dot(n);
             // As `Deform::boundary_speed` rounds a speed along the surface.
@@ -133,8 +142,8 @@ impl<G: Boundaries> Transport<'_, G> {
             } else {
                 along / wn
             };
-            let t = self.slots.twin(j);
-            let s = &mut self.d.slots[t];
+            let t = walk.slots.twin(j);
+            let s = &mut walk.d.slots[t];
             if scattered != 0.0 {
                 s.add_boundary(scattered * tb, (scattered * tb).abs());
             }
@@ -142,88 +151,80 @@ impl<G: Boundaries> Transport<'_, G> {
                 s.add_score(-ke * tb);
             }
             s.u = s.u - vj + w * tb;
-            self.d.touch(t);
+            walk.d.touch(t);
         }
     }
     // ANCHOR_END: twin_gradient
 
     /// The path's state with each twin's derivative added to its
     /// parameter's.
-    pub fn finish(mut self) -> Deform<G::V> {
-        if self.slots.twins > 0 {
-            for j in self.slots.parameter_slots.iter() {
-                let t = &self.d.slots[self.slots.twin(j)];
+    pub fn finish(self) -> Deform<G::V> {
+        let DerivativeWalk { slots, mut d, .. } = self.walk;
+        if slots.twins > 0 {
+            for j in slots.parameter_slots.iter() {
+                let t = &d.slots[slots.twin(j)];
                 let (b, scale) = (t.boundary, t.boundary_scale);
-                self.d.slots[j].add_boundary(b, scale);
+                d.slots[j].add_boundary(b, scale);
             }
         }
-        self.d
+        d
     }
 
-    /// A walk in the frozen scene from `x` along `w` that differentiates
-    /// the start velocities held in `nested`; returns its state. `drawn`:
-    /// how the main path drew `w`, so that a lamp it hits first carries the
-    /// main path's MIS weight (the connection estimates the rest).
-    #[allow(clippy::too_many_arguments)]
+    /// A walk in the frozen scene along `ray` that differentiates the start
+    /// velocities held in `nested`; returns its state. `drawn`: how the
+    /// main path drew the ray's direction, so that a lamp it hits first
+    /// carries the main path's MIS weight (the connection estimates the
+    /// rest).
     fn frozen_walk(
         &mut self,
         g: &G,
         rng: &mut PathRng,
         nested: Deform<G::V>,
-        x: G::V,
-        w: G::V,
-        medium: MediumId,
-        skip: u32,
-        drawn: Option<(f64, G::V)>,
+        ray: Ray<G::V>,
+        drawn: Option<Drawn<G::V>>,
     ) -> Deform<G::V> {
         let mut hooks = Rendering {
-            slots: self.slots,
-            scratch: self.scratch,
-            d: nested,
-            frozen: true,
+            walk: DerivativeWalk {
+                slots: self.walk.slots,
+                scene: SceneMotion::Frozen,
+                scratch: &mut *self.walk.scratch,
+                d: nested,
+            },
         };
-        walk(g, &mut hooks, rng, x, w, medium, skip, 1.0, drawn);
-        hooks.d
+        walk(g, &mut hooks, rng, ray, 1.0, drawn);
+        hooks.walk.d
     }
 }
 
 impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
     #[inline]
     fn boundary(&mut self, g: &G, x: G::V, w: G::V, hit: Option<Hit>) {
-        self.d.segment(g, self.slots, false, x, w, hit);
+        self.walk.segment(g, x, w, hit);
     }
     #[inline]
     fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {
-        let work = &mut self.scratch.work;
-        leibniz(
-            g,
-            &mut self.d,
-            self.slots.frozen_scene(),
-            rng,
-            leg,
-            t_b,
-            work,
-        );
+        let rule = self.walk.slots.frozen_scene();
+        self.walk.leibniz(g, rule, rng, leg, t_b);
     }
     #[inline]
     fn visit(&mut self, _x: G::V) {
-        self.scratch.work.main += 1;
+        self.walk.scratch.work.main += 1;
     }
     #[inline]
     fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
-        self.d.carry(xi);
+        self.walk.d.carry(xi);
     }
     #[inline]
     fn pass(&mut self, ke: f64) {
-        self.d.pass(self.slots.frozen_scene(), ke);
+        self.walk.d.pass(self.walk.slots.frozen_scene(), ke);
     }
     #[inline]
     fn arrive(&mut self, w: G::V, t: f64) {
-        self.d.arrive(self.slots.frozen_scene(), w, t);
+        self.walk.d.arrive(self.walk.slots.frozen_scene(), w, t);
     }
     #[inline]
     fn emission(&mut self, contribution: f64) {
-        self.d.collect(contribution);
+        self.walk.d.collect(contribution);
     }
     #[inline]
     fn opaque(
@@ -233,7 +234,7 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
         leg: &Leg<G>,
         y: G::V,
         k: u32,
-        drawn: Option<(f64, G::V)>,
+        drawn: Option<Drawn<G::V>>,
     ) {
         if self.euler_moving() {
             self.surface_gradient(g, rng, leg, y, k, drawn);
@@ -247,17 +248,23 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
         }
         let (w, before, beta) = (leg.w, leg.medium, leg.beta);
         let eps = g.nudge(y);
-        let ks = |medium: MediumId| g.coefficients(medium).map_or(0.0, |c| c.0);
-        let work = &mut self.scratch.work;
+        let ks = |medium: MediumId| g.coefficients(medium).map_or(0.0, |c| c.ks);
+        let walk = &mut self.walk;
+        let work = &mut walk.scratch.work;
         let side = |work: &mut _, rng: &mut PathRng, medium: MediumId, at: G::V| {
             if ks(medium) > 0.0 {
-                let wi = super::Lobe::sample(&g.phase_lobe(medium, w), rng);
-                ks(medium) * radiance(g, work, rng, at, wi, medium, NO_PRIM)
+                let ray = Ray {
+                    x: at,
+                    w: super::Lobe::sample(&g.phase_lobe(medium, w), rng),
+                    medium,
+                    skip: NO_PRIM,
+                };
+                ks(medium) * radiance(g, work, rng, ray)
             } else {
                 0.0
             }
         };
-        let ke = |medium: MediumId| g.coefficients(medium).map_or(0.0, |c| c.1);
+        let ke = |medium: MediumId| g.coefficients(medium).map_or(0.0, |c| c.ke);
         // The in-scattered radiances by nested paths, as the work admits.
         let scattered = if ks(before) > 0.0 || ks(after) > 0.0 {
             match work.admit(rng) {
@@ -271,61 +278,64 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             0.0
         };
         let dke = ke(before) - ke(after);
-        for j in self.slots.parameter_slots.iter() {
-            let s = &mut self.d.slots[j];
+        let d = &mut walk.d;
+        for j in walk.slots.parameter_slots.iter() {
+            let s = &mut d.slots[j];
             let t = beta * s.tb_dot * scattered;
             s.add_boundary(t, t.abs());
             s.add_score(-dke * s.tb_dot);
             if s.score != 0.0 {
-                self.d.live.insert(j);
+                d.live.insert(j);
             }
         }
     }
     // ANCHOR_END: interface
     #[inline]
     fn reflect(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, v: &Vertex<G>, k: u32) {
-        let moving = self.slots.moving(k);
+        let moving = self.walk.slots.moving(k);
         self.moving_reflector = !moving.is_empty();
         if !self.moving_reflector {
             return;
         }
         // The incoming radiance's gradient at the moving point first.
-        if self.slots.twins > 0 {
+        if self.walk.slots.twins > 0 {
             self.twin_gradient(g, rng, leg, v, k);
         } else {
             self.surface_gradient(g, rng, leg, v.x, k, None);
         }
         // The material derivative of the reflected radiance: the point moves
         // with the surface (the corner terms see it move).
+        let d = &mut self.walk.d;
         for j in moving.iter() {
-            self.d.slots[j].u = g.velocity(j, v.x);
-            self.d.touch(j);
+            d.slots[j].u = g.velocity(j, v.x);
+            d.touch(j);
         }
     }
     #[inline]
     fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
-        attached_connect(g, self.slots, self.scratch, &mut self.d, rng, v, false)
+        self.walk.attached_connect(g, rng, v)
     }
     #[inline]
     fn scatter(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> G::V {
-        let work = &mut self.scratch.work;
-        attached_scatter(g, self.slots, &mut self.d, rng, v, false, work)
+        self.walk.attached_scatter(g, rng, v)
     }
     #[inline]
     fn reflected(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>, w: G::V) {
-        let params = self.slots.parameter_slots;
-        if self.moving_reflector && self.slots.twins > 0 {
+        let slots = self.walk.slots;
+        let params = slots.parameter_slots;
+        if self.moving_reflector && slots.twins > 0 {
             // … and its regular part: the path goes on fixed in space, and
             // the twins carry the moving point's velocities along it in
             // the frozen scene.
+            let d = &mut self.walk.d;
             for j in params.iter() {
-                let t = self.slots.twin(j);
-                let (u, wd) = (self.d.slots[j].u, self.d.slots[j].wd);
-                let s = &mut self.d.slots[t];
+                let t = slots.twin(j);
+                let (u, wd) = (d.slots[j].u, d.slots[j].wd);
+                let s = &mut d.slots[t];
                 s.u = s.u + u;
                 s.wd = s.wd + wd;
-                self.d.slots[j].u = G::V::ZERO;
-                self.d.touch(t);
+                d.slots[j].u = G::V::ZERO;
+                d.touch(t);
             }
             self.moving_reflector = false;
         }
@@ -334,10 +344,10 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             // point in the turning frame, by a nested walk in the frozen
             // scene (as the work admits it); the path itself goes on fixed
             // in space.
-            let admitted = self.scratch.work.admit(rng);
-            let mut nested = self.scratch.take(self.d.len());
+            let admitted = self.walk.scratch.work.admit(rng);
+            let mut nested = self.walk.scratch.take(self.walk.d.len());
             for j in params.iter() {
-                let s = &mut self.d.slots[j];
+                let s = &mut self.walk.d.slots[j];
                 nested.slots[j].u = s.u;
                 nested.slots[j].wd = s.wd;
                 s.u = G::V::ZERO;
@@ -345,22 +355,25 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
             }
             let nested = match admitted {
                 Some(weight) => {
-                    let drawn = Some((super::Lobe::pdf(&v.lobe, w), v.x));
-                    let nested = self.frozen_walk(g, rng, nested, v.x, w, v.medium, v.skip, drawn);
+                    let drawn = Drawn {
+                        pdf: super::Lobe::pdf(&v.lobe, w),
+                        from: v.x,
+                    };
+                    let nested = self.frozen_walk(g, rng, nested, v.ray(w), Some(drawn));
                     for j in params.iter() {
                         let n = &nested.slots[j];
                         let (b, scale) = (n.boundary * weight, n.boundary_scale * weight);
-                        self.d.slots[j].add_boundary(v.beta * b, (v.beta * scale).abs());
+                        self.walk.d.slots[j].add_boundary(v.beta * b, (v.beta * scale).abs());
                     }
                     nested
                 }
                 None => nested,
             };
-            self.scratch.give(nested);
+            self.walk.scratch.give(nested);
             self.moving_reflector = false;
         }
         for j in params.iter() {
-            self.d.slots[j].wd = G::V::ZERO;
+            self.walk.d.slots[j].wd = G::V::ZERO;
         }
     }
 }

@@ -8,7 +8,7 @@
 //! through [`Hooks`] and adds its own terms. Book: chapter "Flatland",
 //! sections "Backward path tracing" and "Next-event estimation".
 use super::thin_media::collision_rate;
-use super::{Geometry, Hit, Lobe, MediumId, NO_PRIM, Prim, Surface, Vector, mis};
+use super::{Coefficients, Geometry, Hit, Lobe, MediumId, NO_PRIM, Prim, Surface, Vector, mis};
 use crate::rng::{PathRng, free_path};
 use rand::RngExt;
 
@@ -35,6 +35,34 @@ pub enum Frame {
     Surface(u32),
     /// The incoming direction's (a collision in a medium).
     Incoming,
+}
+
+/// A ray through the scene: from `x` along the unit `w`, in `medium`,
+/// leaving the primitive `skip` ([`NO_PRIM`]: none), which it does not hit
+/// again at its start. Where a walk, a shadow walk or a nested walk starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray<V> {
+    /// Origin.
+    pub x: V,
+    /// Direction (unit).
+    pub w: V,
+    /// Medium the origin lies in.
+    pub medium: MediumId,
+    /// Primitive the origin lies on.
+    pub skip: Prim,
+}
+
+/// How a walk's direction was drawn, for the multiple importance sampling
+/// of a lamp the walk hits first: with density `pdf` at the scattering
+/// vertex at `from`, where next-event estimation drew that lamp's points
+/// with the light strategy's density. (A walk without it was given its
+/// direction, and counts such a lamp whole.)
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Drawn<V> {
+    /// Density with which the vertex's lobe drew the direction.
+    pub pdf: f64,
+    /// The vertex.
+    pub from: V,
 }
 
 /// A straight leg of a path: from `x` along the unit `w` through `medium`,
@@ -74,6 +102,19 @@ pub struct Vertex<G: Geometry> {
     /// Whether directions here are drawn with the geometry's sensor density
     /// ([`Geometry::sensor_mixture`]) rather than the lobe's.
     pub mixed: bool,
+}
+
+impl<G: Geometry> Vertex<G> {
+    /// The ray leaving the vertex along `w`.
+    #[inline]
+    pub fn ray(&self, w: G::V) -> Ray<G::V> {
+        Ray {
+            x: self.x,
+            w,
+            medium: self.medium,
+            skip: self.skip,
+        }
+    }
 }
 
 // By hand: a derive would ask `G: Copy` of the geometry itself.
@@ -122,9 +163,8 @@ pub trait Hooks<G: Geometry> {
     /// An emission `contribution` is collected.
     #[inline]
     fn emission(&mut self, contribution: f64) {}
-    /// The leg ends on the opaque surface of shape `k` at `y`; the
-    /// scattering vertex `drawn.1` drew its direction with density
-    /// `drawn.0` (`None`: a given direction).
+    /// The leg ends on the opaque surface of shape `k` at `y`; `drawn`:
+    /// how its direction was drawn (`None`: it was given).
     #[inline]
     fn opaque(
         &mut self,
@@ -133,7 +173,7 @@ pub trait Hooks<G: Geometry> {
         leg: &Leg<G>,
         y: G::V,
         k: u32,
-        drawn: Option<(f64, G::V)>,
+        drawn: Option<Drawn<G::V>>,
     ) {
     }
     /// The leg crosses the transparent boundary at `y` into `after`.
@@ -226,46 +266,43 @@ pub fn light_sample<G: Geometry>(
     ))
 }
 
-/// The transmittance along `w` from `x` (in `medium`, leaving `skip`) to
-/// the primitive `target`: `e^{−τ}` through the media crossed, 0 if an
-/// opaque primitive comes first. With `hooks`, every segment's boundary
-/// speed and transmittance derivative (the derivative walks' connections).
+/// The transmittance along `ray` to the primitive `target`: `e^{−τ}`
+/// through the media crossed, 0 if an opaque primitive comes first. With
+/// `hooks`, every segment's boundary speed and transmittance derivative
+/// (the derivative walks' connections).
 #[inline]
 pub fn transmittance<G: Geometry, H: Hooks<G>>(
     g: &G,
     hooks: &mut H,
-    x: G::V,
-    w: G::V,
-    medium: MediumId,
-    skip: Prim,
+    ray: Ray<G::V>,
     target: Prim,
 ) -> f64 {
-    transmittance_by(g, hooks, x, w, medium, skip, target, |x, w, skip| {
-        g.cast(x, w, skip)
-    })
+    transmittance_by(g, hooks, ray, target, |x, w, skip| g.cast(x, w, skip))
 }
 
-/// [`transmittance`] with its rays cast by `cast` (a connection replays the
-/// hits of its shadow walk).
-#[allow(clippy::too_many_arguments)]
+/// [`transmittance`] with its rays cast by `cast(x, w, skip)` (a connection
+/// replays the hits of its shadow walk).
 #[inline]
 pub fn transmittance_by<G: Geometry, H: Hooks<G>>(
     g: &G,
     hooks: &mut H,
-    mut x: G::V,
-    w: G::V,
-    mut medium: MediumId,
-    mut skip: Prim,
+    ray: Ray<G::V>,
     target: Prim,
     mut cast: impl FnMut(G::V, G::V, Prim) -> Option<Hit>,
 ) -> f64 {
+    let Ray {
+        mut x,
+        w,
+        mut medium,
+        mut skip,
+    } = ray;
     let mut tau = 0.0;
     loop {
         let Some(h) = cast(x, w, skip) else {
             return 0.0;
         };
         hooks.boundary(g, x, w, Some(h));
-        if let Some((_, ke)) = g.coefficients(medium) {
+        if let Some(Coefficients { ke, .. }) = g.coefficients(medium) {
             tau += ke * h.t;
             hooks.pass(ke);
         }
@@ -291,34 +328,35 @@ pub fn next_event<G: Geometry>(g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {
     let Some((w, p, c)) = light_sample(g, rng, v) else {
         return 0.0;
     };
-    c * transmittance(g, &mut (), v.x, w, v.medium, v.skip, p)
+    c * transmittance(g, &mut (), v.ray(w), p)
 }
 
 // ANCHOR: walk
-/// One path continued from `x` along `w` with throughput `beta` (`x` in
-/// `medium`, leaving `skip`), `drawn` the density with which the last
-/// scattering vertex drew `w` and that vertex (`None`: the direction was
-/// given, so a lamp hit first counts whole). Returns the radiance it
-/// collects; `hooks` see every event.
-#[allow(clippy::too_many_arguments)]
+/// One path continued along `ray` with throughput `beta`, `drawn` how the
+/// last scattering vertex drew the ray's direction (`None`: it was given,
+/// so a lamp hit first counts whole). Returns the radiance it collects;
+/// `hooks` see every event.
 pub fn walk<G: Geometry, H: Hooks<G>>(
     g: &G,
     hooks: &mut H,
     rng: &mut PathRng,
-    mut x: G::V,
-    mut w: G::V,
-    mut medium: MediumId,
-    mut skip: Prim,
+    ray: Ray<G::V>,
     mut beta: f64,
-    mut drawn: Option<(f64, G::V)>,
+    mut drawn: Option<Drawn<G::V>>,
 ) -> f64 {
+    let Ray {
+        mut x,
+        mut w,
+        mut medium,
+        mut skip,
+    } = ray;
     let mut depth = 0;
     let mut total = 0.0;
     loop {
         let hit = g.cast(x, w, skip);
         let t_b = hit.map_or(f64::INFINITY, |h| h.t);
         hooks.boundary(g, x, w, hit);
-        if let Some((ks, ke)) = g.coefficients(medium) {
+        if let Some(Coefficients { ks, ke }) = g.coefficients(medium) {
             if hit.is_some() {
                 let leg = Leg { x, w, medium, beta };
                 hooks.free_path_domain(g, rng, &leg, t_b);
@@ -351,7 +389,10 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                     total += hooks.connect(g, rng, &v);
                 }
                 w = hooks.scatter(g, rng, &v);
-                drawn = H::NEXT_EVENT.then(|| (v.lobe.pdf(w), x));
+                drawn = H::NEXT_EVENT.then(|| Drawn {
+                    pdf: v.lobe.pdf(w),
+                    from: x,
+                });
                 skip = NO_PRIM;
                 depth += 1;
                 if !survives(depth, &mut beta, rng) {
@@ -376,7 +417,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
         match g.surface(h.prim) {
             Surface::Emitter { radiance } => {
                 hooks.opaque(g, rng, &leg, x, k, drawn);
-                let weight = drawn.map_or(1.0, |(p, from)| mis(p, g.light_pdf(from, x, h.prim)));
+                let weight = drawn.map_or(1.0, |d| mis(d.pdf, g.light_pdf(d.from, x, h.prim)));
                 let contribution = beta * radiance * weight;
                 hooks.emission(contribution);
                 return total + contribution;
@@ -414,7 +455,10 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                 }
                 w = hooks.scatter(g, rng, &v);
                 hooks.reflected(g, rng, &v, w);
-                drawn = H::NEXT_EVENT.then(|| (lobe.pdf(w), x));
+                drawn = H::NEXT_EVENT.then(|| Drawn {
+                    pdf: lobe.pdf(w),
+                    from: x,
+                });
                 depth += 1;
                 if !survives(depth, &mut beta, rng) {
                     return total;
@@ -460,7 +504,7 @@ pub fn reach<G: Geometry>(
     // at q, so a hit short of it is rounding; see `Boundaries::holds`).
     let mut passes = 0;
     loop {
-        let ke = g.coefficients(medium).map_or(0.0, |c| c.1);
+        let ke = g.coefficients(medium).map_or(0.0, |c| c.ke);
         match g.cast(x, w, skip) {
             Some(h) if h.t < left * (1.0 - 1e-9) => {
                 let opaque = g.surface(h.prim) != Surface::Transparent;

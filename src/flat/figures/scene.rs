@@ -23,6 +23,7 @@ use crate::flat::lobe::cosine_direction;
 use crate::flat::space::Plane;
 use crate::flat::{Scene, Sensor, Surface};
 use crate::path::intensity::radiance_observed;
+use crate::path::walk::Ray;
 use crate::plot::{Figure, Panel, Series};
 use crate::rng;
 use glam::DVec2;
@@ -344,10 +345,12 @@ pub fn sample_paths(scene: &Scene, seed: u64) -> Vec<PathRecord> {
                 * radiance_observed(
                     &plane,
                     &mut rng,
-                    x,
-                    w,
-                    scene.sensor_medium(),
-                    NO_SEGMENT,
+                    Ray {
+                        x,
+                        w,
+                        medium: scene.sensor_medium(),
+                        skip: NO_SEGMENT,
+                    },
                     |v| vertices.push([v.x, v.y]),
                 );
             PathRecord { vertices, weight }
