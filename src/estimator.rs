@@ -7,11 +7,24 @@
 //! parameters gets its twelve sensitivities from the same call, and the hot
 //! loop allocates nothing. The [`runner`](crate::runner) turns the weights
 //! into estimates.
-use crate::path::PixelSample;
 use crate::rng::PathRng;
 use crate::stats::{ChunkSums, StratumSums};
 use serde::{Deserialize, Serialize};
 use std::fmt;
+
+/// Where in a camera's image one path starts: pixel `pixel` (row-major,
+/// row 0 at the top), and stratum `stratum` of the `strata × strata` grid
+/// that splits its footprint (the path's direction is uniform in it).
+/// Ignored by the other sensors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PixelSample {
+    /// Pixel index, `row × width + column`.
+    pub pixel: u32,
+    /// Stratum index in `0..strata²`, row-major.
+    pub stratum: u32,
+    /// Strata per side (1: the whole footprint).
+    pub strata: u32,
+}
 
 /// The relative size below which a weight is the rounding residue of terms
 /// that cancel exactly, not a signal: about 450 units of roundoff. A slab

@@ -4,7 +4,8 @@
 //! declaration order, then (transport) the sensor position's gradient.
 //! States are reused across the paths of a chunk: the hot loop allocates
 //! nothing per path.
-use super::deform::{DerivativeWalk, SceneMotion, Slots};
+use super::deform::Slots;
+use super::derivative_walk::{DerivativeWalk, SceneMotion};
 use super::expectation::Expectation;
 use super::nested::{Budget, Scratch, Work};
 use super::rendering::Rendering;

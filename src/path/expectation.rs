@@ -15,7 +15,7 @@
 //!
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Expectation" and "The warp field".
-use super::deform::DerivativeWalk;
+use super::derivative_walk::DerivativeWalk;
 use super::walk::{Hooks, Vertex};
 use super::{Boundaries, Geometry, Hit, Lobe, MovingVertex, Vector};
 use crate::rng::PathRng;

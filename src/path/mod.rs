@@ -24,6 +24,7 @@
 //! the running score) is in [`deform`]. Book: chapters "Flatland" and
 //! "Flatland: one deformation, three estimators".
 pub mod deform;
+pub mod derivative_walk;
 pub mod estimator;
 pub mod expectation;
 pub mod intensity;
@@ -186,19 +187,7 @@ pub enum Sensor<V> {
     },
 }
 
-/// Where in a camera's image one path starts: pixel `pixel` (row-major,
-/// row 0 at the top), and stratum `stratum` of the `strata × strata` grid
-/// that splits its footprint (the path's direction is uniform in it).
-/// Ignored by the other sensors.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct PixelSample {
-    /// Pixel index, `row × width + column`.
-    pub pixel: u32,
-    /// Stratum index in `0..strata²`, row-major.
-    pub stratum: u32,
-    /// Strata per side (1: the whole footprint).
-    pub strata: u32,
-}
+pub use crate::estimator::PixelSample;
 
 /// A primitive (segment, triangle) index; [`NO_PRIM`] for none.
 pub type Prim = u32;

@@ -18,9 +18,10 @@
 //!
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Rendering" and "Corner jumps".
-use super::deform::{Deform, DerivativeWalk, SceneMotion, SlotSet};
+use super::deform::{Deform, SlotSet};
+use super::derivative_walk::{DerivativeWalk, SceneMotion};
 use super::nested::{SurfacePoint, Work, radiance, reflected_jump, surface_radiance};
-use super::walk::{Frame, Hooks, Leg, Ray, Vertex, reach};
+use super::walk::{Frame, Hooks, Leg, Ray, Vertex, light_sample, reach, transmittance_by};
 use super::{
     Boundaries, BoundaryPoint, BoundaryView, Coefficients, Geometry, Hit, Lobe, NO_PRIM, Prim,
     Side, Surface, Vector,
@@ -391,3 +392,114 @@ impl<G: Boundaries> DerivativeWalk<'_, G> {
         w
     }
 }
+
+// ANCHOR: connect
+impl<G: Boundaries> DerivativeWalk<'_, G> {
+    /// Next-event estimation at `v`: one emitter point drawn as the
+    /// intensity estimator draws it; its direction `η` deforms as
+    /// `direction` sets it in a copy of the walk (the method's rule: the
+    /// frame's turn, the warp), the connection's segments follow, and
+    /// `contribution × score` is added to every slot. The connection's
+    /// segments are followed by rendering's hooks (it has no free path, so
+    /// only their boundary speed, transmittance and vertex carrying act).
+    /// The MIS weight is a fixed partition of unity in the method's own
+    /// coordinates over directions, so it is not differentiated (book:
+    /// "Next-event estimation in the derivative walks"). With `precheck`, a
+    /// blocked connection is found by a plain shadow walk before
+    /// `direction` runs (worth it when `direction` costs more than the
+    /// extra ray: the expectation method's warp); its hits are kept, handed
+    /// to `direction` (the first: `Some(hit)`) and replayed to the hooks,
+    /// so no ray is cast twice and the result is the same.
+    pub fn connect(
+        &mut self,
+        g: &G,
+        rng: &mut PathRng,
+        v: &Vertex<G>,
+        precheck: bool,
+        direction: impl FnOnce(&mut DerivativeWalk<'_, G>, G::V, Option<Option<Hit>>),
+    ) -> f64 {
+        let Some((w, p, c)) = light_sample(g, rng, v) else {
+            return 0.0;
+        };
+        // A blocked connection adds nothing, whatever its direction's
+        // velocity: a direction rule that costs more than a shadow ray (the
+        // expectation method's warp) is worth skipping there.
+        let mut record = Recorded::default();
+        if precheck {
+            let cast = |x, w, skip| record.cast(g, x, w, skip);
+            if transmittance_by(g, &mut (), v.ray(w), p, cast) == 0.0 {
+                return 0.0;
+            }
+        }
+        let d = self.scratch.take_copy(&self.d);
+        let mut follow = Rendering {
+            walk: DerivativeWalk {
+                slots: self.slots,
+                scene: self.scene,
+                scratch: &mut *self.scratch,
+                d,
+            },
+        };
+        direction(&mut follow.walk, w, precheck.then(|| record.first()));
+        let mut replay = 0;
+        let cast = |x, w, skip| record.replay(&mut replay, g, x, w, skip);
+        let contribution = c * transmittance_by(g, &mut follow, v.ray(w), p, cast);
+        let tmp = follow.walk.d;
+        if contribution != 0.0 {
+            for j in tmp.live.iter() {
+                let t = &tmp.slots[j];
+                let scale = (contribution * t.score_scale).abs();
+                self.d.slots[j].add_boundary(contribution * t.score, scale);
+            }
+        }
+        self.scratch.give(tmp);
+        contribution
+    }
+}
+
+/// The hits of a connection's shadow walk, kept for its replay (a few: a
+/// connection crosses few media boundaries; past them the replay casts).
+#[derive(Default)]
+struct Recorded {
+    hits: [Option<Hit>; 8],
+    n: usize,
+}
+
+impl Recorded {
+    /// Casts and keeps the hit.
+    #[inline]
+    fn cast<G: Geometry>(&mut self, g: &G, x: G::V, w: G::V, skip: Prim) -> Option<Hit> {
+        let h = g.cast(x, w, skip);
+        if self.n < self.hits.len() {
+            self.hits[self.n] = h;
+            self.n += 1;
+        }
+        h
+    }
+
+    /// The `i`-th hit again (the replay's casts come in the same order with
+    /// the same rays), cast where none was kept.
+    #[inline]
+    fn replay<G: Geometry>(
+        &self,
+        i: &mut usize,
+        g: &G,
+        x: G::V,
+        w: G::V,
+        skip: Prim,
+    ) -> Option<Hit> {
+        let k = *i;
+        *i += 1;
+        if k < self.n {
+            self.hits[k]
+        } else {
+            g.cast(x, w, skip)
+        }
+    }
+
+    /// The first hit.
+    fn first(&self) -> Option<Hit> {
+        self.hits[0]
+    }
+}
+// ANCHOR_END: connect

@@ -16,7 +16,8 @@
 //! The sensor-position slots (`∂I/∂x`, …) follow rendering's rules.
 //! Book: chapter "Flatland: one deformation, three estimators", section
 //! "Transport"; in 3D, chapter "Three dimensions", section "Transport in 3D".
-use super::deform::{Deform, DerivativeWalk, SceneMotion};
+use super::deform::Deform;
+use super::derivative_walk::{DerivativeWalk, SceneMotion};
 use super::nested::radiance;
 use super::rendering::Rendering;
 use super::walk::{Drawn, Hooks, Leg, Ray, Vertex, walk};
