@@ -54,7 +54,7 @@ use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::builder::build_bvh2;
 use obvhs::bvh2::node::Bvh2Node;
-use obvhs::faststack::{FastStack, StackStack};
+use obvhs::faststack::StackStack;
 use obvhs::ray::{Ray, RayHit};
 
 /// Pad of every box and every distance bound, in units of the scene's
@@ -456,18 +456,23 @@ impl<P: Primitive> Tree<P> {
         t_max: f64,
         skip: u32,
     ) -> Option<(f64, u32)> {
-        match self.plan(origin, dir, t_max) {
-            Plan::Miss => None,
-            Plan::Linear => scan_closest(&self.prims, &P::ray(origin, dir), t_max, skip),
-            Plan::Trace(clip) => {
-                let ray = P::ray(origin, dir);
-                with_stack!(
-                    self.depth,
-                    stack,
-                    self.closest_with(stack, &clip, &ray, t_max, skip)
-                )
+        let clip = match self.plan(origin, dir, t_max) {
+            Plan::Miss => return None,
+            Plan::Linear => return scan_closest(&self.prims, &P::ray(origin, dir), t_max, skip),
+            Plan::Trace(clip) => clip,
+        };
+        let ray = P::ray(origin, dir);
+        let mut best = (t_max, NONE);
+        self.traverse(&clip, |prims, r| {
+            for p in prims {
+                if take(&mut best, p, &ray, t_max, skip) {
+                    // Padded: a later equal-t, lower-index hit is still reached.
+                    r.tmax = r.tmax.min(clip.bound(best.0));
+                }
             }
-        }
+            true
+        });
+        (best.1 != NONE).then_some(best)
     }
 
     /// Whether any primitive other than `skip` (`u32::MAX`: none) is
@@ -475,70 +480,36 @@ impl<P: Primitive> Tree<P> {
     /// answer.
     #[inline]
     pub(crate) fn any_hit(&self, origin: P::Vector, dir: P::Vector, t_max: f64, skip: u32) -> bool {
-        match self.plan(origin, dir, t_max) {
-            Plan::Miss => false,
-            Plan::Linear => scan_any(&self.prims, &P::ray(origin, dir), t_max, skip),
-            Plan::Trace(clip) => {
-                let ray = P::ray(origin, dir);
-                with_stack!(
-                    self.depth,
-                    stack,
-                    self.any_with(stack, &clip, &ray, t_max, skip)
-                )
-            }
-        }
-    }
-
-    /// The closest hit by traversal, with `stack` as the traversal stack.
-    #[inline(always)]
-    fn closest_with<S: FastStack<u32>>(
-        &self,
-        stack: &mut S,
-        clip: &Clip,
-        ray: &P::Ray,
-        t_max: f64,
-        skip: u32,
-    ) -> Option<(f64, u32)> {
-        let mut best = (t_max, NONE);
-        let mut leaf = |node: &Bvh2Node, r: &mut Ray, _: &mut RayHit| {
-            let first = node.first_index as usize;
-            for p in &self.prims[first..first + node.prim_count as usize] {
-                if take(&mut best, p, ray, t_max, skip) {
-                    // Padded: a later equal-t, lower-index hit is still reached.
-                    r.tmax = r.tmax.min(clip.bound(best.0));
-                }
-            }
-            true
+        let clip = match self.plan(origin, dir, t_max) {
+            Plan::Miss => return false,
+            Plan::Linear => return scan_any(&self.prims, &P::ray(origin, dir), t_max, skip),
+            Plan::Trace(clip) => clip,
         };
-        self.bvh
-            .ray_traverse_dynamic(stack, clip.ray, &mut RayHit::none(), &mut leaf);
-        (best.1 != NONE).then_some(best)
-    }
-
-    /// Whether any primitive is hit, by traversal with `stack`.
-    #[inline(always)]
-    fn any_with<S: FastStack<u32>>(
-        &self,
-        stack: &mut S,
-        clip: &Clip,
-        ray: &P::Ray,
-        t_max: f64,
-        skip: u32,
-    ) -> bool {
+        let ray = P::ray(origin, dir);
         let mut found = false;
-        let mut leaf = |node: &Bvh2Node, _: &mut Ray, _: &mut RayHit| {
-            let first = node.first_index as usize;
-            found = scan_any(
-                &self.prims[first..first + node.prim_count as usize],
-                ray,
-                t_max,
-                skip,
-            );
+        self.traverse(&clip, |prims, _| {
+            found = scan_any(prims, &ray, t_max, skip);
             !found // false halts the traversal
-        };
-        self.bvh
-            .ray_traverse_dynamic(stack, clip.ray, &mut RayHit::none(), &mut leaf);
+        });
         found
+    }
+
+    /// Traverses the tree along `clip`'s ray, calling `leaf` with the
+    /// primitives of each leaf whose box the ray enters and the ray (whose
+    /// `tmax` it may shorten), until it returns false. The one traversal
+    /// of both queries: they differ only in what a leaf does.
+    #[inline(always)]
+    fn traverse(&self, clip: &Clip, mut leaf: impl FnMut(&[P], &mut Ray) -> bool) {
+        let mut visit = |node: &Bvh2Node, r: &mut Ray, _: &mut RayHit| {
+            let first = node.first_index as usize;
+            leaf(&self.prims[first..first + node.prim_count as usize], r)
+        };
+        with_stack!(
+            self.depth,
+            stack,
+            self.bvh
+                .ray_traverse_dynamic(stack, clip.ray, &mut RayHit::none(), &mut visit)
+        )
     }
 }
 

@@ -29,22 +29,40 @@ pub use crate::scene::camera::{MAX_SIDE, MIN_PIXEL, view_problem};
 
 /// A pinhole camera: file form `{ kind = "camera", position, look_at, up,
 /// fov_deg, width, height }`; `fov_deg` is the horizontal field of view
-/// (Mitsuba's default axis), pixels are square.
+/// (Mitsuba's default axis), pixels are square. The sensor's file form
+/// holds this one (`crate::mesh::scene::repr`), so each field is read
+/// through a reader that names it in errors.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
     /// The pinhole.
+    #[serde(deserialize_with = "form::position")]
     pub position: DVec3,
     /// A point on the view axis.
+    #[serde(deserialize_with = "form::look_at")]
     pub look_at: DVec3,
     /// Up, roughly (not along the view axis).
+    #[serde(deserialize_with = "form::up")]
     pub up: DVec3,
     /// Horizontal field of view in degrees, in `(0, 170]`.
+    #[serde(deserialize_with = "form::fov_deg")]
     pub fov_deg: f64,
     /// Pixels per row.
+    #[serde(deserialize_with = "form::width")]
     pub width: u32,
     /// Rows.
+    #[serde(deserialize_with = "form::height")]
     pub height: u32,
+}
+
+/// The readers of [`Camera`]'s fields (`crate::scene::repr::fields`): serde
+/// buffers a tagged table, so its own message would not say which field is
+/// wrong.
+mod form {
+    use crate::scene::repr::fields;
+    use glam::DVec3;
+    fields!(position: DVec3, look_at: DVec3, up: DVec3);
+    fields!(fov_deg: f64, width: u32, height: u32);
 }
 
 impl Camera {

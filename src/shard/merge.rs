@@ -26,7 +26,6 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
     let Some((first_label, first)) = labelled.first() else {
         return Err(Error::Merge("nothing to merge: no state given".into()));
     };
-    let this_version = env!("CARGO_PKG_VERSION");
     let n = first.run.shards;
     // The count comes from a file: checked before a slot per shard is
     // allocated (a damaged count must be an error, not an abort).
@@ -34,18 +33,7 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
     let mut by_index: Vec<Option<&(String, State)>> = vec![None; n as usize];
     for pair in labelled {
         let (label, s) = pair;
-        if s.version != this_version {
-            return Err(Error::Merge(format!(
-                "{label}: written by geosens {}, this is {this_version}",
-                s.version
-            )));
-        }
-        if s.run != first.run {
-            return Err(Error::Merge(format!(
-                "{label} and {first_label} are not of one run: {}",
-                differences(&s.run, &first.run)
-            )));
-        }
+        of_one_run(label, s, first_label, first)?;
         if !same_header(&s.header, &first.header)
             || s.caveats != first.caveats
             || s.quantities != first.quantities
@@ -141,6 +129,31 @@ pub fn merge(labelled: &[(String, State)]) -> Result<Merged, Error> {
     })
 }
 
+/// Checks that state `s` was written by this version of geosens and is of
+/// the run of `first`, naming them by `label` and `first_label`: what
+/// [`merge`] and [`survey`] ask of every state first.
+pub(super) fn of_one_run(
+    label: &str,
+    s: &State,
+    first_label: &str,
+    first: &State,
+) -> Result<(), Error> {
+    let this_version = env!("CARGO_PKG_VERSION");
+    if s.version != this_version {
+        return Err(Error::Merge(format!(
+            "{label}: written by geosens {}, this is {this_version}",
+            s.version
+        )));
+    }
+    if s.run != first.run {
+        return Err(Error::Merge(format!(
+            "{label} and {first_label} are not of one run: {}",
+            differences(&s.run, &first.run)
+        )));
+    }
+    Ok(())
+}
+
 /// Whether two shards' headers are of one run: equal but for the scene's
 /// name (a shard may name the same file by another path; the hash compares
 /// the contents, and the merge prints the first state's name).
@@ -202,7 +215,7 @@ fn misplaced(s: &State, first: &State) -> Option<String> {
 }
 
 /// Which fields of two run identities differ, for a message.
-pub(super) fn differences(a: &RunId, b: &RunId) -> String {
+fn differences(a: &RunId, b: &RunId) -> String {
     let mut d = Vec::new();
     if a.method != b.method {
         d.push(format!("method {} against {}", a.method, b.method));

@@ -96,22 +96,10 @@ pub fn survey(labelled: &[(String, State)], shards: Option<u64>) -> Result<Surve
             first.shard
         )));
     }
-    let this_version = env!("CARGO_PKG_VERSION");
     let mut by_index: Vec<Option<&str>> = vec![None; n as usize];
     let (mut paths, mut seconds) = (0u64, 0.0);
     for (label, s) in labelled {
-        if s.version != this_version {
-            return Err(Error::Merge(format!(
-                "{label}: written by geosens {}, this is {this_version}",
-                s.version
-            )));
-        }
-        if s.run != first.run {
-            return Err(Error::Merge(format!(
-                "{label} and {first_label} are not of one run: {}",
-                merge::differences(&s.run, &first.run)
-            )));
-        }
+        merge::of_one_run(label, s, first_label, first)?;
         let shard = Shard::new(s.shard, n).map_err(|e| Error::Merge(format!("{label}: {e}")))?;
         let slot = &mut by_index[(shard.index - 1) as usize];
         if let Some(other) = slot {

@@ -10,29 +10,31 @@ pub(super) fn rod_command(
     args: &RodArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let job = Job {
-        target: Target::Rod(RodProbe {
-            ks: args.ks,
-            ke: args.ke,
-            length: args.length,
-            x: args.x,
-            omega: args.omega,
-        }),
-        method: args.method.0,
-        fd_step: args.fd.fd_step,
-    };
-    estimate(&job, &args.run, &args.shard, args.json, out)
+    let target = Target::Rod(RodProbe {
+        ks: args.ks,
+        ke: args.ke,
+        length: args.length,
+        x: args.x,
+        omega: args.omega,
+    });
+    estimate(target, args.method.0, &args.estimate, out)
 }
 
-/// Runs `job` (or its shard, with `--state`) and prints its report.
+/// Runs `method` (`None`: the exact solution) on `target` as `args` say
+/// (or its shard, with `--state`) and prints its report.
 fn estimate(
-    job: &Job,
-    run: &RunArgs,
-    shard: &ShardArgs,
-    json: bool,
+    target: Target,
+    method: Option<Method>,
+    args: &EstimateArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let cfg = run.config(1_000_000)?;
+    let job = Job {
+        target,
+        method,
+        fd_step: args.fd.fd_step,
+    };
+    let (shard, json) = (&args.shard, args.json);
+    let cfg = args.run.config(1_000_000)?;
     let method = job.method.map_or("exact", Method::name);
     let Some(path) = &shard.state else {
         if let Some(s) = shard.shard {
@@ -386,11 +388,8 @@ pub(super) fn flat_command(
     args: &SceneArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    scene_command(
-        args,
-        Target::Flat(SceneSource::File(args.scene.clone())),
-        out,
-    )
+    let target = Target::Flat(SceneSource::File(args.scene.clone()));
+    estimate(target, Some(args.method), &args.estimate, out)
 }
 
 /// `geosens mesh`.
@@ -398,23 +397,6 @@ pub(super) fn mesh_command(
     args: &SceneArgs,
     out: &mut impl Write,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    scene_command(
-        args,
-        Target::Mesh(SceneSource::File(args.scene.clone())),
-        out,
-    )
-}
-
-/// A run of `args.method` on a scene file: a table or one JSON line.
-fn scene_command(
-    args: &SceneArgs,
-    target: Target,
-    out: &mut impl Write,
-) -> Result<(), Box<dyn std::error::Error>> {
-    let job = Job {
-        target,
-        method: Some(args.method),
-        fd_step: args.fd.fd_step,
-    };
-    estimate(&job, &args.run, &args.shard, args.json, out)
+    let target = Target::Mesh(SceneSource::File(args.scene.clone()));
+    estimate(target, Some(args.method), &args.estimate, out)
 }

@@ -115,6 +115,16 @@ struct SceneArgs {
     /// Estimation method.
     #[arg(long, value_enum)]
     method: Method,
+    /// The fd half step, the run, the sharding and the output form.
+    #[command(flatten)]
+    estimate: EstimateArgs,
+}
+
+/// What `rod`, `flat` and `mesh` take after the probe: how to run the
+/// estimation and print its result (one struct, so that the three
+/// subcommands' options stay alike).
+#[derive(Debug, Args)]
+struct EstimateArgs {
     /// The finite differences' half step.
     #[command(flatten)]
     fd: FdArgs,
@@ -163,18 +173,9 @@ struct RodArgs {
     /// Probe direction ω: 1 (right) or -1 (left).
     #[arg(long, allow_hyphen_values = true)]
     omega: f64,
-    /// The finite differences' half step.
+    /// The fd half step, the run, the sharding and the output form.
     #[command(flatten)]
-    fd: FdArgs,
-    /// The run configuration.
-    #[command(flatten)]
-    run: RunArgs,
-    /// Sharding.
-    #[command(flatten)]
-    shard: ShardArgs,
-    /// Print one JSON line instead of a table.
-    #[arg(long)]
-    json: bool,
+    estimate: EstimateArgs,
 }
 
 /// `geosens compare`: the table's run, and where the figures go.

@@ -1,8 +1,79 @@
 //! Unit tests of the boundary points' density (against the draws).
 use super::*;
+use crate::mesh::edges::Edge;
 use crate::mesh::file;
 use std::path::Path;
 use std::sync::Arc;
+
+/// The fog-free showcase (a cube, 12 moving edges, under a two-triangle
+/// lamp), the scene of every test here.
+fn showcase_nofog() -> Space {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mesh/showcase_nofog.toml");
+    Space::new(Arc::new(file::load(&path).unwrap()))
+}
+
+/// The angle under which `x` sees the segment from `a` to `b`.
+fn angle(x: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let (ra, rb) = (a - x, b - x);
+    ra.cross(rb).length().atan2(ra.dot(rb))
+}
+
+/// `Σ inv_pdf / n` per `bins`-th of each edge's arc seen from `x`, over the
+/// boundary points added, and the arc of each edge drawn: what the density
+/// tests compare, each bin against its share of the arc.
+struct ArcBins<'t> {
+    x: DVec3,
+    edges: &'t [Edge],
+    n: usize,
+    bins: usize,
+    sums: Vec<f64>,
+    arcs: Vec<f64>,
+}
+
+impl<'t> ArcBins<'t> {
+    /// Empty bins for `n` draws from `x` over `edges`.
+    fn new(x: DVec3, edges: &'t [Edge], n: usize, bins: usize) -> ArcBins<'t> {
+        ArcBins {
+            x,
+            edges,
+            n,
+            bins,
+            sums: vec![0.0; edges.len() * bins],
+            arcs: vec![0.0; edges.len()],
+        }
+    }
+
+    /// Adds boundary point `b`, whose `inv_pdf` must be finite and
+    /// positive.
+    fn add(&mut self, b: BoundaryPoint<DVec3>) {
+        assert!(b.inv_pdf.is_finite() && b.inv_pdf > 0.0);
+        let e = b.index as usize;
+        let edge = &self.edges[e];
+        let arc = angle(self.x, edge.a, edge.b);
+        let alpha = angle(self.x, edge.a, b.q);
+        let bin = ((alpha / arc * self.bins as f64) as usize).min(self.bins - 1);
+        self.sums[e * self.bins + bin] += b.inv_pdf / self.n as f64;
+        self.arcs[e] = arc;
+    }
+
+    /// Checks that every edge of `drawn` was drawn and that each bin of its
+    /// arc holds its share of the arc within 0.4 % (`at` names the case in
+    /// the messages).
+    fn check<'e>(&self, drawn: impl Iterator<Item = &'e u32>, at: &str) {
+        for &e in drawn {
+            let e = e as usize;
+            assert!(self.arcs[e] > 0.0, "{at}: edge {e} never drawn");
+            for bin in 0..self.bins {
+                let want = self.arcs[e] / self.bins as f64;
+                let got = self.sums[e * self.bins + bin];
+                assert!(
+                    (got / want - 1.0).abs() < 0.004,
+                    "{at}, edge {e}, bin {bin}: {got} against {want}"
+                );
+            }
+        }
+    }
+}
 
 /// `E[inv_pdf · 1{q in a piece of arc}]` is the piece's length
 /// whatever the density, if `inv_pdf` is the inverse of the density
@@ -17,8 +88,7 @@ use std::sync::Arc;
 /// the lamp parts fails it).
 #[test]
 fn the_boundary_density_is_that_of_the_draws() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mesh/showcase_nofog.toml");
-    let space = Space::new(Arc::new(file::load(&path).unwrap()));
+    let space = showcase_nofog();
     let tables = space.edge_tables();
     let n = 1_600_000;
     let bins = 8;
@@ -40,47 +110,19 @@ fn the_boundary_density_is_that_of_the_draws() {
             if space.lamp_overlaps(x, tree).1 > 0.0 {
                 with_lamp += 1;
             }
-            let mut sums = vec![0.0; tables.edges.len() * bins];
-            let mut arcs = vec![0.0; tables.edges.len()];
+            let mut arc_bins = ArcBins::new(x, &tables.edges, n, bins);
             for k in 0..n {
                 let u = (k as f64 + 0.5) / n as f64;
                 // The drawn point and those taken every time, the same
                 // grid for both numbers (the sum's expectation is the sum
                 // of theirs).
                 let stratum = if all { Stratum::All } else { Stratum::Moving };
-                space.edge_points(
-                    x,
-                    stratum,
-                    Some((u, 1.0)),
-                    u,
-                    |_| true,
-                    |b| {
-                        assert!(b.inv_pdf.is_finite() && b.inv_pdf > 0.0);
-                        let e = b.index as usize;
-                        let edge = &tables.edges[e];
-                        let (ra, rb, rq) = (edge.a - x, edge.b - x, b.q - x);
-                        let arc = ra.cross(rb).length().atan2(ra.dot(rb));
-                        let alpha = ra.cross(rq).length().atan2(ra.dot(rq));
-                        let bin = ((alpha / arc * bins as f64) as usize).min(bins - 1);
-                        sums[e * bins + bin] += b.inv_pdf / n as f64;
-                        arcs[e] = arc;
-                    },
-                );
+                space.edge_points(x, stratum, Some((u, 1.0)), u, |_| true, |b| arc_bins.add(b));
             }
-            for &e in tree.edges().iter().chain(&tables.lamp_set[all as usize]) {
-                let e = e as usize;
-                // Every edge here is a discontinuity from everywhere
-                // (open, or a reflector's crease): each must be drawn.
-                assert!(arcs[e] > 0.0, "x {x}, all {all}: edge {e} never drawn");
-                for bin in 0..bins {
-                    let want = arcs[e] / bins as f64;
-                    let got = sums[e * bins + bin];
-                    assert!(
-                        (got / want - 1.0).abs() < 0.004,
-                        "x {x}, all {all}, edge {e}, bin {bin}: {got} against {want}"
-                    );
-                }
-            }
+            // Every edge here is a discontinuity from everywhere (open, or
+            // a reflector's crease): each must be drawn.
+            let drawn = tree.edges().iter().chain(&tables.lamp_set[all as usize]);
+            arc_bins.check(drawn, &format!("x {x}, all {all}"));
         }
     }
     assert!(
@@ -99,8 +141,7 @@ fn the_boundary_density_is_that_of_the_draws() {
 /// the piece's angle, per eighth of the arc to 1e-9).
 #[test]
 fn the_lamp_edges_are_taken_once_and_never_drawn() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mesh/showcase_nofog.toml");
-    let space = Space::new(Arc::new(file::load(&path).unwrap()));
+    let space = showcase_nofog();
     let tables = space.edge_tables();
     let lamp = |e: u32| tables.edges[e as usize].shape == 0;
     assert_eq!(tables.lamp_set[1], vec![0, 1, 2, 3]);
@@ -129,10 +170,9 @@ fn the_lamp_edges_are_taken_once_and_never_drawn() {
                 |b| {
                     seen.push(b.index);
                     let edge = &tables.edges[b.index as usize];
-                    let (ra, rb, rq) = (edge.a - x, edge.b - x, b.q - x);
-                    let arc = ra.cross(rb).length().atan2(ra.dot(rb));
+                    let arc = angle(x, edge.a, edge.b);
                     assert!((b.inv_pdf - arc).abs() < 1e-12 * arc);
-                    let alpha = ra.cross(rq).length().atan2(ra.dot(rq));
+                    let alpha = angle(x, edge.a, b.q);
                     assert!(
                         (alpha - u * arc).abs() < 1e-9,
                         "x {x}: {alpha} against {}",
@@ -153,8 +193,7 @@ fn the_lamp_edges_are_taken_once_and_never_drawn() {
         }
         for e in 0..4 {
             let edge = &tables.edges[e];
-            let (ra, rb) = (edge.a - x, edge.b - x);
-            let arc = ra.cross(rb).length().atan2(ra.dot(rb));
+            let arc = angle(x, edge.a, edge.b);
             for bin in 0..bins {
                 let got = sums[e * bins + bin];
                 assert!(
@@ -177,8 +216,7 @@ fn the_lamp_edges_are_taken_once_and_never_drawn() {
 #[test]
 fn the_split_among_the_slots_covers_every_edge_once() {
     use crate::path::deform::SlotSet;
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/mesh/showcase_nofog.toml");
-    let space = Space::new(Arc::new(file::load(&path).unwrap()));
+    let space = showcase_nofog();
     let tables = space.edge_tables();
     let mut all = SlotSet::EMPTY;
     all.insert(2);
@@ -196,34 +234,13 @@ fn the_split_among_the_slots_covers_every_edge_once() {
         DVec3::new(0.25, 0.1, 0.0),
         DVec3::new(-0.3, 0.0, 0.85),
     ] {
-        let mut sums = vec![0.0; tables.edges.len() * bins];
-        let mut arcs = vec![0.0; tables.edges.len()];
+        let mut arc_bins = ArcBins::new(x, &tables.edges, n, bins);
         for k in 0..n {
             let u = (k as f64 + 0.5) / n as f64;
             let u_pick = ((k % picks) as f64 + 0.5) / picks as f64;
-            space.split_points(x, &view, 1, [u, u, u_pick], |b| {
-                assert!(b.inv_pdf.is_finite() && b.inv_pdf > 0.0);
-                let e = b.index as usize;
-                let edge = &tables.edges[e];
-                let (ra, rb, rq) = (edge.a - x, edge.b - x, b.q - x);
-                let arc = ra.cross(rb).length().atan2(ra.dot(rb));
-                let alpha = ra.cross(rq).length().atan2(ra.dot(rq));
-                let bin = ((alpha / arc * bins as f64) as usize).min(bins - 1);
-                sums[e * bins + bin] += b.inv_pdf / n as f64;
-                arcs[e] = arc;
-            });
+            space.split_points(x, &view, 1, [u, u, u_pick], |b| arc_bins.add(b));
         }
-        for &e in tables.all_drawn.edges().iter().chain(&tables.lamp_set[1]) {
-            let e = e as usize;
-            assert!(arcs[e] > 0.0, "x {x}: edge {e} never drawn");
-            for bin in 0..bins {
-                let want = arcs[e] / bins as f64;
-                let got = sums[e * bins + bin];
-                assert!(
-                    (got / want - 1.0).abs() < 0.004,
-                    "x {x}, edge {e}, bin {bin}: {got} against {want}"
-                );
-            }
-        }
+        let drawn = tables.all_drawn.edges().iter().chain(&tables.lamp_set[1]);
+        arc_bins.check(drawn, &format!("x {x}"));
     }
 }

@@ -1,15 +1,16 @@
 //! The file forms of [`Motion`](super::Motion) and [`Sensor`](super::Sensor),
 //! written as `crate::scene::repr` says: every variant of a tagged enum a
 //! struct variant (else `{ kind = "translate_x", pivot = [0, 0, 0] }` would
-//! load without a word), fields read through `crate::scene::repr::field`
-//! so that errors name them. Surfaces and phase functions have one file form
-//! for both dimensions, in `crate::scene::material`.
+//! load without a word), or one holding a struct that refuses unknown
+//! fields (the camera's, [`Camera`](crate::mesh::camera::Camera), written
+//! once), fields read through `crate::scene::repr::field` so that errors
+//! name them. Surfaces and phase functions have one file form for both
+//! dimensions, in `crate::scene::material`.
 use crate::scene::repr::fields;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 fields!(axis: DVec3, pivot: Option<DVec3>, point: DVec3, direction: DVec3, normal: DVec3);
-fields!(position: DVec3, look_at: DVec3, up: DVec3, fov_deg: f64, width: u32, height: u32);
 
 #[derive(Clone, Copy, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
@@ -76,20 +77,7 @@ pub enum Sensor {
         #[serde(deserialize_with = "normal")]
         normal: DVec3,
     },
-    Camera {
-        #[serde(deserialize_with = "position")]
-        position: DVec3,
-        #[serde(deserialize_with = "look_at")]
-        look_at: DVec3,
-        #[serde(deserialize_with = "up")]
-        up: DVec3,
-        #[serde(deserialize_with = "fov_deg")]
-        fov_deg: f64,
-        #[serde(deserialize_with = "width")]
-        width: u32,
-        #[serde(deserialize_with = "height")]
-        height: u32,
-    },
+    Camera(crate::mesh::camera::Camera),
 }
 
 impl From<Sensor> for super::Sensor {
@@ -97,21 +85,7 @@ impl From<Sensor> for super::Sensor {
         match s {
             Sensor::Radiance { point, direction } => Self::Radiance { point, direction },
             Sensor::Irradiance { point, normal } => Self::Irradiance { point, normal },
-            Sensor::Camera {
-                position,
-                look_at,
-                up,
-                fov_deg,
-                width,
-                height,
-            } => Self::Camera(crate::mesh::camera::Camera {
-                position,
-                look_at,
-                up,
-                fov_deg,
-                width,
-                height,
-            }),
+            Sensor::Camera(c) => Self::Camera(c),
         }
     }
 }
@@ -121,14 +95,7 @@ impl From<super::Sensor> for Sensor {
         match s {
             super::Sensor::Radiance { point, direction } => Self::Radiance { point, direction },
             super::Sensor::Irradiance { point, normal } => Self::Irradiance { point, normal },
-            super::Sensor::Camera(c) => Self::Camera {
-                position: c.position,
-                look_at: c.look_at,
-                up: c.up,
-                fov_deg: c.fov_deg,
-                width: c.width,
-                height: c.height,
-            },
+            super::Sensor::Camera(c) => Self::Camera(c),
         }
     }
 }
