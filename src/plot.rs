@@ -225,7 +225,8 @@ pub const PALETTE: [RGBColor; 8] = [
     RGBColor(240, 228, 66),
 ];
 
-fn plot_err<E: std::fmt::Debug>(e: E) -> Error {
+/// A plotters error as the crate's.
+pub(crate) fn plot_err<E: std::fmt::Debug>(e: E) -> Error {
     Error::Output(format!("plotting failed: {e:?}"))
 }
 

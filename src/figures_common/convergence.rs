@@ -1,23 +1,34 @@
 //! The convergence figures of flatland and 3D: every method ([`METHODS`])
 //! run at 10³ to 10⁶ paths on one scene, σ and |mean − exact| against the
-//! number of paths, log–log.
+//! number of paths, log–log; and the pieces of such a panel the rod's
+//! figures draw too (a method's σ and errors, the `∝ 1/√N` slope, the
+//! panel with its legend's key).
 use super::{FigureOptions, get, run_method};
 use super::{METHODS, REFERENCE_COLOR, color};
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::method::{Method, Problem};
 use crate::plot::{Legend, Panel, Series, quiet_corner, spread};
-use crate::rod::figures::convergence::path_counts;
 use serde::Serialize;
 use std::sync::Arc;
+
+/// Path counts in half decades from `10^lo` to `10^hi`, ends included
+/// (before the effort scaling).
+pub fn path_counts(lo: u32, hi: u32) -> Vec<u64> {
+    (2 * lo..=2 * hi)
+        .map(|k| 10f64.powf(f64::from(k) / 2.0).round() as u64)
+        .collect()
+}
 
 /// One estimate of one run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Record {
     /// Method name.
     pub method: &'static str,
-    /// The parameter of the panel.
-    pub parameter: &'static str,
+    /// The parameter of the panel; `None` where the figure has one and
+    /// names it once, beside the records (flatland's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub parameter: Option<&'static str>,
     /// `"E"` (intensity) or `"dE/dπ"`.
     pub quantity: &'static str,
     /// Paths sampled, `N`.
@@ -67,7 +78,7 @@ where
                 let est = get(&r, &q)?;
                 runs.push(Record {
                     method: method.name(),
-                    parameter,
+                    parameter: Some(parameter),
                     quantity,
                     paths: r.paths,
                     mean: est.mean,
@@ -86,9 +97,14 @@ where
 }
 
 /// The log–log panel titled `title`: σ as lines, |error| as dots, of the
-/// `(method, N, σ, error)` of `rows`, and a `∝ 1/√N` line a factor 3 under
-/// the lowest σ at the largest N.
-pub(crate) fn panel(title: String, rows: &[(&str, u64, f64, f64)]) -> Panel {
+/// records of `parameter`, and a `∝ 1/√N` line a factor 3 under the lowest
+/// σ at the largest N.
+pub(crate) fn panel(title: String, records: &[Record], parameter: &str) -> Panel {
+    let rows: Vec<_> = records
+        .iter()
+        .filter(|r| r.parameter == Some(parameter))
+        .map(|r| (r.method, r.paths, r.stderr, r.error))
+        .collect();
     let mut series = Vec::new();
     for (k, method) in METHODS.into_iter().enumerate() {
         let rs: Vec<_> = rows.iter().filter(|r| r.0 == method.name()).collect();
@@ -104,14 +120,7 @@ pub(crate) fn panel(title: String, rows: &[(&str, u64, f64, f64)]) -> Panel {
                 )
             })
             .collect();
-        let label = super::label(method);
-        // Transport's σ lies on rendering's: dashed over it.
-        if method == Method::Transport {
-            series.push(Series::dashes(&label, color(method), sigma));
-        } else {
-            series.push(Series::line(&label, color(method), sigma));
-        }
-        series.push(Series::points("", color(method), error));
+        series.extend(sigma_and_error(method, &super::label(method), sigma, error));
     }
     // The reference slope, a factor 3 under the lowest σ at the largest N
     // so that it hides no curve.
@@ -125,30 +134,9 @@ pub(crate) fn panel(title: String, rows: &[(&str, u64, f64, f64)]) -> Panel {
         .map(|r| r.2)
         .fold(f64::INFINITY, f64::min);
     if lowest.is_finite() {
-        let k = lowest / 3.0 * hi.sqrt();
-        series.push(Series::dashed(
-            "∝ 1/√N",
-            REFERENCE_COLOR,
-            vec![(lo, k / lo.sqrt()), (hi, k / hi.sqrt())],
-        ));
+        series.push(slope("∝ 1/√N", lowest / 3.0 * hi.sqrt(), (lo, hi)));
     }
-    // What lines and dots are, first in the legend (they draw nothing).
-    series.splice(
-        0..0,
-        [
-            Series::line("σ (lines)", REFERENCE_COLOR, vec![]),
-            Series::legend_dot("|mean − exact| (dots)", REFERENCE_COLOR),
-        ],
-    );
-    let mut panel = Panel {
-        title,
-        x_label: "N (paths)".into(),
-        y_label: "σ (lines), |mean − exact| (dots)".into(),
-        x_log: true,
-        y_log: true,
-        series,
-        ..Panel::default()
-    };
+    let mut panel = sigma_panel(title, "N (paths)", series);
     panel.legend = quiet_corner(
         &panel,
         &[Legend::LowerLeft, Legend::UpperRight],
@@ -156,4 +144,54 @@ pub(crate) fn panel(title: String, rows: &[(&str, u64, f64, f64)]) -> Panel {
     )
     .0;
     panel
+}
+
+/// `method`'s σ against `x` as a line labelled `label` (dashed for
+/// transport: its σ lies on rendering's, which shows through) and its
+/// `(x, |mean − exact|, 0)` as dots.
+pub(crate) fn sigma_and_error(
+    method: Method,
+    label: &str,
+    sigma: Vec<(f64, f64)>,
+    error: Vec<(f64, f64, f64)>,
+) -> [Series; 2] {
+    let line = if method == Method::Transport {
+        Series::dashes
+    } else {
+        Series::line
+    };
+    [
+        line(label, color(method), sigma),
+        Series::points("", color(method), error),
+    ]
+}
+
+/// The dashed reference `c/√x` from `x = lo` to `hi`, labelled `label`:
+/// the rate of an unbiased finite-variance estimator.
+pub(crate) fn slope(label: &str, c: f64, (lo, hi): (f64, f64)) -> Series {
+    Series::dashed(
+        label,
+        REFERENCE_COLOR,
+        vec![(lo, c / lo.sqrt()), (hi, c / hi.sqrt())],
+    )
+}
+
+/// The log–log panel titled `title` of σ (lines) and |mean − exact| (dots)
+/// against `x_label`, drawing `series` after two legend entries that say
+/// what lines and dots are (they draw nothing).
+pub(crate) fn sigma_panel(title: String, x_label: &str, series: Vec<Series>) -> Panel {
+    let mut all = vec![
+        Series::line("σ (lines)", REFERENCE_COLOR, vec![]),
+        Series::legend_dot("|mean − exact| (dots)", REFERENCE_COLOR),
+    ];
+    all.extend(series);
+    Panel {
+        title,
+        x_label: x_label.into(),
+        y_label: "σ (lines), |mean − exact| (dots)".into(),
+        x_log: true,
+        y_log: true,
+        series: all,
+        ..Panel::default()
+    }
 }

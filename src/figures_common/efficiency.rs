@@ -5,7 +5,8 @@ use super::{FigureOptions, run_method, save};
 use super::{METHODS, color};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::method::{Method, Problem};
+use crate::method::Method;
+use crate::method::model::Model;
 use crate::plot::{Figure, Panel, Series};
 use crate::runner::RunResult;
 use crate::stats::Estimate;
@@ -36,6 +37,12 @@ pub struct Record {
     pub work: f64,
 }
 
+/// Runs shorter than this (seconds) are repeated for a robust time.
+pub const MIN_SECONDS: f64 = 0.1;
+
+/// The top of the log axis over the largest bar, as a factor.
+const HEADROOM: f64 = 2.0;
+
 /// What differs between the flatland and the 3D efficiency figure.
 pub(crate) struct Spec<S: 'static> {
     /// Prefix of the files (`flat`, `mesh`).
@@ -44,38 +51,29 @@ pub(crate) struct Spec<S: 'static> {
     pub scenes: &'static [&'static str],
     /// The scene of a panel name.
     pub build: fn(&str) -> Result<S, Error>,
-    /// The names of a scene's parameters.
-    pub parameters: fn(&S) -> Vec<String>,
     /// A panel's title before `": σ²·t per quantity …"`.
     pub title: fn(&str) -> String,
     /// Paths per run (times the effort).
     pub paths: u64,
-    /// Runs shorter than this (seconds) are repeated for a robust time.
-    pub min_seconds: f64,
     /// Most runs of one configuration when timing short runs.
     pub max_repeats: u32,
     /// Base of the seed salts.
     pub salt: u64,
-    /// The top of the log axis over the largest bar.
-    pub headroom: f64,
     /// Pixels per panel.
     pub panel_size: (u32, u32),
 }
 
 /// The run with the fastest of a few identical repeats when short.
-fn timed<S: 'static>(
+fn timed<S: Model>(
     opts: &FigureOptions,
     spec: &Spec<S>,
     method: Method,
     scene: &Arc<S>,
     salt: u64,
-) -> Result<RunResult, Error>
-where
-    Arc<S>: Problem,
-{
+) -> Result<RunResult, Error> {
     let mut best = run_method(opts, method, scene, spec.paths, salt, 1)?;
     let (mut total, mut repeats) = (best.seconds, 1);
-    while total < spec.min_seconds && repeats < spec.max_repeats {
+    while total < MIN_SECONDS && repeats < spec.max_repeats {
         let again = run_method(opts, method, scene, spec.paths, salt, 1)?;
         total += again.seconds;
         repeats += 1;
@@ -157,13 +155,10 @@ fn panel(title: String, groups: &[String], records: &[Record], floor: f64, top: 
 
 /// Times every method on every scene of `spec`, draws the bars and writes
 /// `<prefix>_efficiency.{png,svg,json}`.
-pub(crate) fn efficiency<S: 'static>(
+pub(crate) fn efficiency<S: Model>(
     opts: &FigureOptions,
     spec: &Spec<S>,
-) -> Result<Vec<PathBuf>, Error>
-where
-    Arc<S>: Problem,
-{
+) -> Result<Vec<PathBuf>, Error> {
     let what = format!("{}: efficiency", spec.prefix);
     let bar = opts.bar((spec.scenes.len() * METHODS.len()) as u64, &what);
     let mut salt = spec.salt;
@@ -172,7 +167,7 @@ where
     for &name in spec.scenes {
         let scene = Arc::new((spec.build)(name)?);
         let mut g = vec!["E".to_string()];
-        g.extend((spec.parameters)(&scene));
+        g.extend(scene.parameter_names().map(str::to_owned));
         for method in METHODS {
             salt += 1;
             let r = timed(opts, spec, method, &scene, salt)?;
@@ -205,7 +200,7 @@ where
     let (floor, top) = if lo.is_finite() && hi > 0.0 {
         // A decade at least half a decade under the smallest bar, so that
         // every bar shows its height.
-        (10f64.powf((lo.log10() - 0.5).floor()), hi * spec.headroom)
+        (10f64.powf((lo.log10() - 0.5).floor()), hi * HEADROOM)
     } else {
         (1e-12, 1.0)
     };
@@ -224,5 +219,6 @@ where
         .collect();
     let mut figure = Figure::new(panels, 1).share_legend();
     figure.panel_size = spec.panel_size;
-    save(opts, spec.prefix, "efficiency", &figure, &records)
+    let name = format!("{}_efficiency", spec.prefix);
+    save(opts, &name, &figure, &records)
 }

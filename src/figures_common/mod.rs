@@ -1,17 +1,22 @@
-//! What the flatland and 3D figures ([`crate::flat::figures`],
-//! [`crate::mesh::figures`]) share: the methods they show and their
-//! colours, running a method on a scene, the figure list runner, saving a figure with its numbers, the legend labels,
-//! and the experiments whose logic is the same on both kinds of scene (the
-//! `σ²·t` grouped bars, the sweeps against `π`, the convergence panel, the
-//! runs near singular configurations), parameterised by what differs.
+//! What the figures of every dimension share, written once: the options
+//! every figure takes ([`FigureOptions`]), the methods the flatland and 3D
+//! figures ([`crate::flat::figures`], [`crate::mesh::figures`]) show with
+//! their colours and legend labels, running a method on a scene (or on the
+//! rod at a probe), finding a parameter by name, the figure list runner,
+//! saving a figure with its numbers; and the experiments whose logic is the
+//! same on both kinds of scene (the sweeps against `π`, the convergence
+//! panel, whose pieces the rod's figures draw too, the `σ²·t` grouped bars,
+//! the runs near singular configurations), parameterised by what differs.
+//! Nothing here depends on a dimension's scene types: a scene is a
+//! [`Model`] or a [`Problem`].
 use crate::error::Error;
 use crate::estimator::Quantity;
+use crate::method::model::Model;
 use crate::method::{Method, Problem};
 use crate::runner::{RunConfig, RunResult, run};
 use crate::stats::Estimate;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
-use std::sync::Arc;
 
 pub(crate) mod convergence;
 pub(crate) mod efficiency;
@@ -146,21 +151,27 @@ pub(crate) fn all(opts: &FigureOptions, figures: &[FigureFn]) -> Result<Vec<Path
     Ok(written)
 }
 
-/// Runs `method` on `scene` with `paths` (scaled by the effort) paths, seed
-/// `opts.seed + salt`, on `threads` threads.
-pub(crate) fn run_method<S>(
+/// Runs `method` on `problem` (a flatland or 3D scene, or the rod at a
+/// probe) with `paths` (scaled by the effort) paths, seed `opts.seed +
+/// salt`, on `threads` threads.
+pub fn run_method<P: Problem>(
     opts: &FigureOptions,
     method: Method,
-    scene: &Arc<S>,
+    problem: &P,
     paths: u64,
     salt: u64,
     threads: usize,
-) -> Result<RunResult, Error>
-where
-    Arc<S>: Problem,
-{
+) -> Result<RunResult, Error> {
     let cfg = RunConfig::new(opts.paths(paths), opts.seed.wrapping_add(salt))?.threads(threads);
-    run(method.estimator(Arc::clone(scene))?.as_ref(), &cfg)
+    run(problem.estimator(method, None)?.as_ref(), &cfg)
+}
+
+/// Index of the parameter called `name` in `scene`.
+pub fn parameter<S: Model>(scene: &S, name: &str) -> Result<usize, Error> {
+    scene
+        .parameter_names()
+        .position(|p| p == name)
+        .ok_or_else(|| Error::Scene(format!("the scene has no parameter {name:?}")))
 }
 
 /// The estimate of `q` in `r`, or an error naming the method.
@@ -188,18 +199,17 @@ pub fn label(method: Method) -> String {
     }
 }
 
-/// Saves `figure` as `<prefix>_<name>.{png,svg}` with its numbers,
-/// `<prefix>_<name>.json`; returns the files written.
+/// Saves `figure` as `<name>.{png,svg}` with its numbers, `<name>.json`
+/// (`name` with the dimension's prefix, as `flat_warp`); returns the files
+/// written.
 pub(crate) fn save<T: serde::Serialize>(
     opts: &FigureOptions,
-    prefix: &str,
     name: &str,
     figure: &crate::plot::Figure,
     numbers: &T,
 ) -> Result<Vec<PathBuf>, Error> {
-    let name = format!("{prefix}_{name}");
-    let mut written = figure.save(&opts.out, &name)?;
-    written.push(opts.write_json(&name, numbers)?);
+    let mut written = figure.save(&opts.out, name)?;
+    written.push(opts.write_json(name, numbers)?);
     Ok(written)
 }
 

@@ -1,16 +1,16 @@
 //! The runs of the flatland and 3D stability figures: every derivative
 //! method ([`DERIVATIVE_METHODS`]) on a scene built at each distance to a
 //! singular configuration, the sensitivity to its parameter `p` judged;
-//! and the two rows of panels that show them (the per-path variance with
-//! its error bar, and the bias).
+//! and the figure that shows them, one column per case: the per-path
+//! variance with its error bar above, the bias below.
 use super::{DERIVATIVE_METHODS, REFERENCE_COLOR, color};
-use super::{FigureOptions, get, run_method};
+use super::{FigureOptions, get, run_method, save, z};
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::method::Problem;
-use crate::plot::{Panel, Series, spread};
-use crate::stats::Estimate;
+use crate::plot::{Figure, Panel, Series, spread};
 use serde::Serialize;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 /// One run.
@@ -39,14 +39,17 @@ pub struct Record {
     pub z: Option<f64>,
 }
 
-/// One case: its name, its distances, its paths per run (times the
-/// effort), and the scene (parameter `p`) at a distance with its exact
-/// `∂E/∂p` if known.
-pub(crate) type Case<'a, S> = (
+/// One case: its name (in the records), its panels' title, the label of
+/// its distance axis, its distances, its paths per run (times the effort),
+/// and the scene (parameter `p`) at a distance with its exact `∂E/∂p` if
+/// known.
+pub(crate) type Case<S> = (
     &'static str,
-    &'a [f64],
+    &'static str,
+    &'static str,
+    &'static [f64],
     u64,
-    &'a dyn Fn(f64) -> Result<(S, Option<f64>), Error>,
+    fn(f64) -> Result<(S, Option<f64>), Error>,
 );
 
 /// The seeds of the runs: `opts.seed` plus a salt.
@@ -60,25 +63,23 @@ pub(crate) enum Salt {
 }
 
 /// Runs every derivative method on `opts.threads` at every distance of
-/// every case, seeds from `salt`; `z` scores an estimate against the exact
-/// value. `what` names the progress bar.
-pub(crate) fn measure<S>(
+/// every case, seeds from `salt`. `what` names the progress bar.
+fn measure<S>(
     opts: &FigureOptions,
     what: &str,
-    cases: &[Case<'_, S>],
+    cases: &[Case<S>],
     salt: Salt,
-    z: fn(&Estimate, f64) -> Option<f64>,
 ) -> Result<Vec<Record>, Error>
 where
     Arc<S>: Problem,
 {
-    let total: usize = cases.iter().map(|c| c.1.len()).sum();
+    let total: usize = cases.iter().map(|c| c.3.len()).sum();
     let bar = opts.bar((total * DERIVATIVE_METHODS.len()) as u64, what);
     let mut records = Vec::new();
     let mut next = match salt {
         Salt::Each(s) | Salt::All(s) => s,
     };
-    for &(case, distances, paths, build) in cases {
+    for &(case, _, _, distances, paths, build) in cases {
         for &distance in distances {
             let (scene, exact) = build(distance)?;
             let scene = Arc::new(scene);
@@ -98,7 +99,7 @@ where
                     variance: e.stderr * e.stderr * r.paths as f64,
                     vov: e.vov,
                     exact,
-                    z: exact.and_then(|x| z(&e, x)),
+                    z: exact.and_then(|x| z(e.mean, e.stderr, x)),
                 });
                 bar.inc(1);
             }
@@ -112,7 +113,7 @@ where
 /// `"∂E/∂π"`) against the distance, log–log, every derivative method as
 /// points with error bars `±σ²N·√VOV` (the VOV is the relative variance of
 /// the variance estimate), the methods side by side.
-pub(crate) fn variance_panel(
+fn variance_panel(
     case: &str,
     title: &str,
     axis: &str,
@@ -154,7 +155,7 @@ pub(crate) fn variance_panel(
 /// The case's bias against the distance: `(mean − exact)/σ` with a bar of
 /// one, clamped to ±12, dashed lines at ±4, where every run has an exact
 /// value; the estimates themselves (`mean ± σ`) where not.
-pub(crate) fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Record]) -> Panel {
+fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Record]) -> Panel {
     let mine: Vec<&Record> = records
         .iter()
         .filter(|r| r.case == case && r.distance > 0.0)
@@ -203,4 +204,34 @@ pub(crate) fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Re
         series,
         ..Panel::default()
     }
+}
+
+/// Runs every case of `cases` (one column each: the variance above, the
+/// bias below, `derivative` naming `∂E/∂p` on the axes), seeds from
+/// `salt`, and writes `<prefix>_stability.{png,svg,json}` with panels of
+/// `panel_size` pixels.
+pub(crate) fn figure<S>(
+    opts: &FigureOptions,
+    prefix: &str,
+    cases: &[Case<S>],
+    salt: Salt,
+    derivative: &str,
+    panel_size: (u32, u32),
+) -> Result<Vec<PathBuf>, Error>
+where
+    Arc<S>: Problem,
+{
+    let records = measure(opts, &format!("{prefix}: stability"), cases, salt)?;
+    let mut panels: Vec<Panel> = cases
+        .iter()
+        .map(|&(case, title, axis, ..)| variance_panel(case, title, axis, derivative, &records))
+        .collect();
+    panels.extend(
+        cases
+            .iter()
+            .map(|&(case, _, axis, ..)| bias_panel(case, axis, derivative, &records)),
+    );
+    let mut figure = Figure::new(panels, cases.len()).share_legend();
+    figure.panel_size = panel_size;
+    save(opts, &format!("{prefix}_stability"), &figure, &records)
 }

@@ -1,16 +1,21 @@
-//! The sweeps of the flatland and 3D "against π" figures: a scene moved to
-//! evenly spaced values of one parameter `π`, every method run there (`E`
+//! The flatland and 3D figures "against π": each sweep moves a scene to
+//! evenly spaced values of one parameter `π`, runs every method there (`E`
 //! from the intensity estimator, `∂E/∂π` from the derivative methods) and
-//! drawn as markers with ±σ bars over the reference curves, one column of
-//! two panels (`E`, `∂E/∂π`) per sweep.
-use super::{DERIVATIVE_METHODS, color};
+//! draws them as markers with ±σ bars over the reference curves, one
+//! column of two panels (`E`, `∂E/∂π`) per sweep. What a sweep moves and
+//! what its reference is, is the dimension's ([`Column`]).
+use super::{DERIVATIVE_METHODS, REFERENCE_COLOR, color};
 use super::{FigureOptions, get, grid, run_method, z};
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::method::{Method, Problem};
-use crate::plot::{Panel, Series};
+use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
+use indicatif::ProgressBar;
 use serde::Serialize;
 use std::sync::Arc;
+
+/// Values of `π` per sweep (ends included).
+pub const VALUES: usize = 13;
 
 /// The methods run at every value of `π`: intensity, then the derivative
 /// methods.
@@ -22,32 +27,53 @@ pub(crate) fn methods() -> impl Iterator<Item = Method> {
 /// factor the estimators' `∂E/∂π` is multiplied by to be that one.
 pub(crate) type Exact = (f64, f64, f64);
 
-/// Reference curves: `π`, `E(π)`, `∂E/∂π(π)`.
-pub(crate) type Curves = (Vec<f64>, Vec<f64>, Vec<f64>);
+/// One sweep, one column of the figure: what the figure asks of the
+/// dimension's scene moved along one of its parameters.
+pub(crate) trait Column {
+    /// The scene the methods run on.
+    type Scene;
+    /// The swept parameter: the sensitivity judged.
+    fn parameter(&self) -> &'static str;
+    /// First and last value of `π`.
+    fn range(&self) -> (f64, f64);
+    /// The scene file written beside every record and curve, where the
+    /// figure's sweeps move different scenes (flatland's).
+    fn file(&self) -> Option<&'static str>;
+    /// The scene as the panels' titles name it.
+    fn title(&self) -> String;
+    /// The label of the `π` axis.
+    fn axis(&self) -> String;
+    /// The reference curve's `E` and `∂E/∂π` at `π`.
+    fn curve_at(&self, pi: f64) -> Result<(f64, f64), Error>;
+    /// The scene moved to `π`, holding the swept parameter, and its
+    /// reference.
+    fn at(&self, pi: f64) -> Result<(Arc<Self::Scene>, Exact), Error>;
+}
 
-/// The reference curves over `range` at `n` points.
-pub(crate) fn curve(
-    range: (f64, f64),
-    n: usize,
-    exact: impl Fn(f64) -> Result<(f64, f64), Error>,
-) -> Result<Curves, Error> {
-    let pi = grid(range, n);
-    let mut e = Vec::with_capacity(pi.len());
-    let mut de = Vec::with_capacity(pi.len());
-    for &p in &pi {
-        let (v, d) = exact(p)?;
-        e.push(v);
-        de.push(d);
-    }
-    Ok((pi, e, de))
+/// What else differs between the flatland and the 3D figure.
+pub(crate) struct Spec {
+    /// Prefix of the files (`flat`, `mesh`).
+    pub prefix: &'static str,
+    /// Points of the reference curves per sweep.
+    pub curve_points: usize,
+    /// Paths per run (times the effort).
+    pub paths: u64,
+    /// Base of the seed salts.
+    pub salt: u64,
+    /// A legend in every panel (else none: the figure's legend is the
+    /// caller's).
+    pub legends: bool,
 }
 
 /// One estimate at one value of `π`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Record {
+    /// Scene file name, where the figure's sweeps move different scenes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scene: Option<&'static str>,
     /// The parameter.
     pub parameter: &'static str,
-    /// Its value.
+    /// Its value (the scene moved by it).
     pub pi: f64,
     /// Method name.
     pub method: &'static str,
@@ -59,35 +85,81 @@ pub struct Record {
     pub mean: f64,
     /// Its standard error.
     pub stderr: f64,
-    /// Relative variance of the variance.
-    pub vov: f64,
+    /// Relative variance of the variance (flatland's JSON leaves it out).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vov: Option<f64>,
     /// The reference.
     pub exact: f64,
-    /// `(mean − exact) / stderr` (see [`z`](crate::mesh::figures::z)).
+    /// `(mean − exact) / stderr`; 0 when the estimate is exact, `None`
+    /// when `stderr = 0` but the estimate is not (finite differences whose
+    /// step no path's visibility changes within).
     pub z: Option<f64>,
 }
 
-/// Runs every method ([`methods`]) with `paths` paths on `opts.threads` at
-/// every value of `values`, on the scene `at` gives with its reference; the
-/// sensitivity judged is `parameter`'s. One salt a run, from `salt` on.
-pub(crate) fn measure<S>(
+/// The reference curve of one sweep.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Curve {
+    /// Scene file name, where the figure's sweeps move different scenes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scene: Option<&'static str>,
+    /// The parameter.
+    pub parameter: &'static str,
+    /// Values of `π`.
+    pub pi: Vec<f64>,
+    /// `E(π)`.
+    pub e: Vec<f64>,
+    /// `∂E/∂π(π)`.
+    pub de: Vec<f64>,
+}
+
+/// The numbers behind the figure.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AgainstPi {
+    /// Every estimate.
+    pub records: Vec<Record>,
+    /// The reference curves.
+    pub curves: Vec<Curve>,
+}
+
+/// The reference curve of `sweep` at `n` points.
+fn curve<C: Column>(sweep: &C, n: usize) -> Result<Curve, Error> {
+    let pi = grid(sweep.range(), n);
+    let mut e = Vec::with_capacity(pi.len());
+    let mut de = Vec::with_capacity(pi.len());
+    for &p in &pi {
+        let (v, d) = sweep.curve_at(p)?;
+        e.push(v);
+        de.push(d);
+    }
+    Ok(Curve {
+        scene: sweep.file(),
+        parameter: sweep.parameter(),
+        pi,
+        e,
+        de,
+    })
+}
+
+/// Runs every method ([`methods`]) with `spec.paths` paths on
+/// `opts.threads` at [`VALUES`] values of `π` over the sweep's range. One
+/// salt a run, from `salt` on.
+fn measure<C: Column>(
     opts: &FigureOptions,
-    values: Vec<f64>,
-    parameter: &'static str,
-    paths: u64,
+    spec: &Spec,
+    sweep: &C,
     salt: &mut u64,
-    bar: &indicatif::ProgressBar,
-    at: impl Fn(f64) -> Result<(Arc<S>, Exact), Error>,
+    bar: &ProgressBar,
 ) -> Result<Vec<Record>, Error>
 where
-    Arc<S>: Problem,
+    Arc<C::Scene>: Problem,
 {
+    let parameter = sweep.parameter();
     let mut runs = Vec::new();
-    for pi in values {
-        let (scene, (e, de, factor)) = at(pi)?;
+    for pi in grid(sweep.range(), VALUES) {
+        let (scene, (e, de, factor)) = sweep.at(pi)?;
         for method in methods() {
             *salt += 1;
-            let r = run_method(opts, method, &scene, paths, *salt, opts.threads)?;
+            let r = run_method(opts, method, &scene, spec.paths, *salt, opts.threads)?;
             let (q, quantity, exact, f) = match method {
                 Method::Intensity => (Quantity::Intensity, "E", e, 1.0),
                 _ => (Quantity::sensitivity(parameter), "dE/dπ", de, factor),
@@ -95,6 +167,7 @@ where
             let est = get(&r, &q)?;
             let (mean, stderr) = (est.mean * f, est.stderr * f);
             runs.push(Record {
+                scene: sweep.file(),
                 parameter,
                 pi,
                 method: method.name(),
@@ -102,7 +175,7 @@ where
                 paths: r.paths,
                 mean,
                 stderr,
-                vov: est.vov,
+                vov: Some(est.vov),
                 exact,
                 z: z(mean, stderr, exact),
             });
@@ -114,18 +187,36 @@ where
 
 /// The panels' quantities and their axis labels: `E` on the top row,
 /// `∂E/∂π` below.
-pub(crate) const QUANTITIES: [(&str, &str); 2] = [("E", "E (irradiance)"), ("dE/dπ", "∂E/∂π")];
+const QUANTITIES: [(&str, &str); 2] = [("E", "E (irradiance)"), ("dE/dπ", "∂E/∂π")];
+
+/// `(π, y)` split where `y` jumps (a step far larger than its neighbours'),
+/// so that a jump is drawn as a gap rather than a steep line.
+fn pieces(xy: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    let steps: Vec<f64> = xy.windows(2).map(|w| (w[1].1 - w[0].1).abs()).collect();
+    let span = xy.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max)
+        - xy.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    let mut out = vec![Vec::new()];
+    for (i, &p) in xy.iter().enumerate() {
+        if i > 0 {
+            let s = steps[i - 1];
+            let before = if i >= 2 { steps[i - 2] } else { 0.0 };
+            let after = steps.get(i).copied().unwrap_or(0.0);
+            if s > 1e-3 * span && s > 8.0 * before.max(after) {
+                out.push(Vec::new());
+            }
+        }
+        if let Some(last) = out.last_mut() {
+            last.push(p);
+        }
+    }
+    out
+}
 
 /// The markers of the panel of `quantity`: every method that estimates it,
 /// side by side (`step` is the spacing of the values of `π`) so that the
-/// error bars do not hide each other; `points` gives a method's
-/// `(π, mean, stderr)`. Labelled by [`super::label`] when `labelled`.
-pub(crate) fn markers(
-    quantity: &str,
-    step: f64,
-    labelled: bool,
-    points: impl Fn(Method) -> Vec<(f64, f64, f64)>,
-) -> Vec<Series> {
+/// error bars do not hide each other. Labelled by [`super::label`] when
+/// `labelled`.
+fn markers(quantity: &str, step: f64, labelled: bool, records: &[Record]) -> Vec<Series> {
     let methods: Vec<Method> = if quantity == "E" {
         vec![Method::Intensity]
     } else {
@@ -134,9 +225,10 @@ pub(crate) fn markers(
     let mut series = Vec::new();
     for (k, &method) in methods.iter().enumerate() {
         let offset = (k as f64 - 0.5 * (methods.len() - 1) as f64) * 0.1 * step;
-        let points = points(method)
-            .into_iter()
-            .map(|(pi, mean, stderr)| (pi + offset, mean, stderr))
+        let points = records
+            .iter()
+            .filter(|r| r.method == method.name() && r.quantity == quantity)
+            .map(|r| (r.pi + offset, r.mean, r.stderr))
             .collect();
         let label = if labelled {
             super::label(method)
@@ -148,40 +240,101 @@ pub(crate) fn markers(
     series
 }
 
-/// What [`columns`] returns.
-pub(crate) struct Columns<R, C> {
-    /// Every sweep's records, in order.
-    pub records: Vec<R>,
-    /// Every sweep's reference curve.
-    pub curves: Vec<C>,
-    /// The `E` panels.
-    pub top: Vec<Panel>,
-    /// The `∂E/∂π` panels.
-    pub bottom: Vec<Panel>,
+/// The two panels of one sweep, `E` and `∂E/∂π`, each over its reference
+/// curve (jumps drawn as gaps); with a legend in a quiet corner when
+/// `labelled`.
+fn panels<C: Column>(sweep: &C, curve: &Curve, records: &[Record], labelled: bool) -> [Panel; 2] {
+    let (lo, hi) = sweep.range();
+    let step = (hi - lo) / (VALUES - 1) as f64;
+    let corners = [
+        Legend::UpperRight,
+        Legend::UpperLeft,
+        Legend::LowerRight,
+        Legend::LowerLeft,
+    ];
+    QUANTITIES.map(|(quantity, y_label)| {
+        let ys = if quantity == "E" { &curve.e } else { &curve.de };
+        let xy: Vec<(f64, f64)> = curve.pi.iter().copied().zip(ys.iter().copied()).collect();
+        let mut series = Vec::new();
+        for (i, piece) in pieces(&xy).into_iter().enumerate() {
+            let label = if labelled && i == 0 { "analytic" } else { "" };
+            series.push(Series::line(label, REFERENCE_COLOR, piece));
+        }
+        series.extend(markers(quantity, step, labelled, records));
+        let mut panel = Panel {
+            title: format!(
+                "{}: {} against {}",
+                sweep.title(),
+                quantity.replace("dE/dπ", "∂E/∂π"),
+                curve.parameter
+            ),
+            x_label: sweep.axis(),
+            y_label: y_label.into(),
+            series,
+            ..Panel::default()
+        };
+        if labelled {
+            panel.legend = quiet_corner(&panel, &corners, (0.35, 0.3)).0;
+        }
+        panel
+    })
 }
 
-/// Runs every sweep of `sweeps` (its reference curve, its runs, its two
-/// panels) in order.
-pub(crate) fn columns<W, C, R>(
-    sweeps: &[W],
-    curve: impl Fn(&W) -> Result<C, Error>,
-    mut measure: impl FnMut(&W) -> Result<Vec<R>, Error>,
-    panels: impl Fn(&W, &C, &[R]) -> [Panel; 2],
-) -> Result<Columns<R, C>, Error> {
-    let mut out = Columns {
+/// Runs every sweep of `sweeps` (its reference curve, its runs) and draws
+/// them, one column each, `E` on the top row and `∂E/∂π` below; returns the
+/// numbers and the figure (to be saved as `<prefix>_against_pi`).
+pub(crate) fn figure<C: Column>(
+    opts: &FigureOptions,
+    spec: &Spec,
+    sweeps: &[C],
+) -> Result<(AgainstPi, Figure), Error>
+where
+    Arc<C::Scene>: Problem,
+{
+    let runs = sweeps.len() * VALUES * methods().count();
+    let bar = opts.bar(runs as u64, &format!("{}: against π", spec.prefix));
+    let mut salt = spec.salt;
+    let mut numbers = AgainstPi {
         records: Vec::new(),
         curves: Vec::new(),
-        top: Vec::new(),
-        bottom: Vec::new(),
     };
+    let (mut top, mut bottom) = (Vec::new(), Vec::new());
     for sweep in sweeps {
-        let c = curve(sweep)?;
-        let r = measure(sweep)?;
-        let [e, de] = panels(sweep, &c, &r);
-        out.top.push(e);
-        out.bottom.push(de);
-        out.records.extend(r);
-        out.curves.push(c);
+        let c = curve(sweep, spec.curve_points)?;
+        let r = measure(opts, spec, sweep, &mut salt, &bar)?;
+        let [e, de] = panels(sweep, &c, &r, spec.legends);
+        top.push(e);
+        bottom.push(de);
+        numbers.records.extend(r);
+        numbers.curves.push(c);
     }
-    Ok(out)
+    bar.finish();
+    top.extend(bottom);
+    Ok((numbers, Figure::new(top, sweeps.len())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jumps_break_the_curve() {
+        let xy: Vec<(f64, f64)> = (0..20)
+            .map(|i| {
+                let x = f64::from(i) / 19.0;
+                (x, x + if x > 0.5 { 1.0 } else { 0.0 })
+            })
+            .collect();
+        let p = pieces(&xy);
+        assert_eq!(p.len(), 2);
+        assert_eq!(p[0].len() + p[1].len(), 20);
+        // A kink is not a jump.
+        let kink: Vec<(f64, f64)> = (0..20)
+            .map(|i| {
+                let x = f64::from(i) / 19.0 - 0.5;
+                (x, x.abs())
+            })
+            .collect();
+        assert_eq!(pieces(&kink).len(), 1);
+    }
 }

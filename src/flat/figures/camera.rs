@@ -4,9 +4,10 @@
 //! ([`line_camera_image`], and its central differences for the
 //! sensitivities). Book: chapter "Three dimensions", section "A camera", "In
 //! flatland: a line camera".
-use super::{FigureOptions, REFERENCE_COLOR, color, load, save};
+use super::{FigureOptions, REFERENCE_COLOR, color, load};
 use crate::error::Error;
 use crate::estimator::Quantity;
+use crate::figures_common::save;
 use crate::flat::exact::line_camera_image;
 use crate::image::render;
 use crate::method::{Method, Problem};
@@ -122,5 +123,5 @@ pub fn camera(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     }
     let mut figure = Figure::new(panels, 3).share_legend();
     figure.panel_size = (560, 420);
-    save(opts, "camera", &figure, &numbers)
+    save(opts, "flat_camera", &figure, &numbers)
 }

@@ -9,9 +9,10 @@
 //! black surface has no gradient) and what is left are rendering's corner
 //! terms: the two estimators are the same here (with one seed they agree
 //! bit for bit), so their curves differ only by their seeds.
-use super::{FigureOptions, exact, load, only, parameter, save};
+use super::{FigureOptions, exact, load, only, parameter};
 use crate::error::Error;
 use crate::figures_common::convergence::{measure, panel};
+use crate::figures_common::save;
 use crate::plot::Figure;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -26,28 +27,7 @@ pub const PARAMETER: &str = "gamma_rotate";
 /// Base of the seed salts of this figure (distinct from the other figures').
 const SALT: u64 = 50_000_000;
 
-/// One run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Record {
-    /// Method name.
-    pub method: &'static str,
-    /// `"E"` (intensity) or `"dE/dπ"`.
-    pub quantity: &'static str,
-    /// Paths sampled, `N`.
-    pub paths: u64,
-    /// The estimate.
-    pub mean: f64,
-    /// Its standard error σ.
-    pub stderr: f64,
-    /// The closed form.
-    pub exact: f64,
-    /// `mean − exact`.
-    pub error: f64,
-    /// Relative variance of the variance (tail diagnostic).
-    pub vov: f64,
-    /// Sampling wall time in seconds.
-    pub seconds: f64,
-}
+pub use crate::figures_common::convergence::Record;
 
 /// The numbers behind `flat_convergence.{png,svg}`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -56,7 +36,7 @@ pub struct Convergence {
     pub scene: &'static str,
     /// The parameter.
     pub parameter: &'static str,
-    /// Every run.
+    /// Every run (without the parameter, named above).
     pub records: Vec<Record>,
 }
 
@@ -70,40 +50,18 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let j = parameter(&base, PARAMETER)?;
     let scene = Arc::new(only(&base, j)?);
     let (e, de) = exact(&scene, 0)?;
-    let runs = measure(
-        opts,
-        "flat: convergence",
-        &scene,
-        e,
-        &[(PARAMETER, de)],
-        SALT,
-    )?;
-    let records = runs
-        .into_iter()
-        .map(|r| Record {
-            method: r.method,
-            quantity: r.quantity,
-            paths: r.paths,
-            mean: r.mean,
-            stderr: r.stderr,
-            exact: r.exact,
-            error: r.error,
-            vov: r.vov,
-            seconds: r.seconds,
-        })
-        .collect();
+    let what = "flat: convergence";
+    let mut records = measure(opts, what, &scene, e, &[(PARAMETER, de)], SALT)?;
+    let title = format!("{SCENE}.toml, π = {PARAMETER}: error against paths");
+    let mut figure = Figure::new(vec![panel(title, &records, PARAMETER)], 1);
+    figure.panel_size = (900, 620);
+    for r in &mut records {
+        r.parameter = None;
+    }
     let c = Convergence {
         scene: SCENE,
         parameter: PARAMETER,
         records,
     };
-    let rows: Vec<_> = c
-        .records
-        .iter()
-        .map(|r| (r.method, r.paths, r.stderr, r.error))
-        .collect();
-    let title = format!("{}.toml, π = {}: error against paths", c.scene, c.parameter);
-    let mut figure = Figure::new(vec![panel(title, &rows)], 1);
-    figure.panel_size = (900, 620);
-    save(opts, "convergence", &figure, &c)
+    save(opts, "flat_convergence", &figure, &c)
 }

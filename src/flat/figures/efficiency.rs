@@ -19,16 +19,13 @@ use crate::error::Error;
 use crate::figures_common::efficiency::{self, Spec};
 use std::path::PathBuf;
 
-pub use crate::figures_common::efficiency::Record;
+pub use crate::figures_common::efficiency::{MIN_SECONDS, Record};
 
 /// The scenes, one panel each.
 pub const SCENES: [&str; 3] = ["polygon_occluder", "fog", "three_shapes"];
 
 /// Paths per run (times the effort).
 pub const PATHS: u64 = 400_000;
-
-/// Runs shorter than this (seconds) are repeated for a robust time.
-pub const MIN_SECONDS: f64 = 0.1;
 
 /// Most runs of one configuration when timing short runs.
 pub const MAX_REPEATS: u32 = 5;
@@ -44,13 +41,10 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         prefix: "flat",
         scenes: &SCENES,
         build: load,
-        parameters: |scene| scene.parameters().iter().map(|p| p.name.clone()).collect(),
         title: |name| format!("{name}.toml"),
         paths: PATHS,
-        min_seconds: MIN_SECONDS,
         max_repeats: MAX_REPEATS,
         salt: SALT,
-        headroom: 2.0,
         panel_size: (1500, 440),
     };
     efficiency::efficiency(opts, &spec)

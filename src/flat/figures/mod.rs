@@ -1,22 +1,26 @@
 //! Flatland's figures (the book's chapter "Flatland"): each is one function
 //! that runs its experiment, deterministic from the seed, draws it with
 //! [`crate::plot`] and writes `flat_<name>.{png,svg}` and the numbers behind
-//! it, `flat_<name>.json`, under the output folder. They take the rod's
-//! [`FigureOptions`]; the examples `examples/fig_flat_*.rs` each call one and
-//! `geosens compare --figures DIR` calls them all after the rod's.
+//! it, `flat_<name>.json`, under the output folder. They take the
+//! [`FigureOptions`] every figure takes; the examples `examples/fig_flat_*.rs`
+//! each call one and `geosens compare --figures DIR` calls them all after
+//! the rod's. What does not depend on the dimension (the methods, their
+//! colours and labels, running one, and the experiments against `π`, of
+//! convergence, efficiency and stability) is written once, for the 3D
+//! figures too; these files say what flatland's scenes and references are.
 //!
 //! The scenes are the files of `scenes/`, compiled in ([`scene_file`]), so
 //! the figures do not depend on the working directory.
 use super::exact::Reference;
-use super::{Method, Scene, file};
+use super::{Scene, file};
 use crate::error::Error;
 use crate::figures_common;
-use crate::runner::RunResult;
 use std::path::PathBuf;
-use std::sync::Arc;
 
-pub use crate::figures_common::{DERIVATIVE_METHODS, METHODS, REFERENCE_COLOR, color};
-pub use crate::rod::figures::{FigureFn, FigureOptions};
+pub use crate::figures_common::{
+    DERIVATIVE_METHODS, FigureFn, FigureOptions, METHODS, REFERENCE_COLOR, color, get, label,
+    parameter, run_method, z,
+};
 
 pub mod against_pi;
 pub mod camera;
@@ -66,15 +70,6 @@ pub fn load(name: &str) -> Result<Scene, Error> {
     file::from_toml(text).map_err(|e| Error::Scene(format!("scenes/{name}.toml: {e}")))
 }
 
-/// Index of the parameter called `name` in `scene`.
-pub fn parameter(scene: &Scene, name: &str) -> Result<usize, Error> {
-    scene
-        .parameters()
-        .iter()
-        .position(|p| p.name == name)
-        .ok_or_else(|| Error::Scene(format!("the scene has no parameter {name:?}")))
-}
-
 /// `scene` with parameter `j` only (pivots stay resolved), so that a run
 /// pays for that one sensitivity; its index becomes 0.
 pub fn only(scene: &Scene, j: usize) -> Result<Scene, Error> {
@@ -89,28 +84,4 @@ pub fn only(scene: &Scene, j: usize) -> Result<Scene, Error> {
 pub fn exact(scene: &Scene, j: usize) -> Result<(f64, f64), Error> {
     let r = Reference::for_scene(scene)?;
     Ok((r.value(), r.derivative(j)))
-}
-
-/// Runs `method` on `scene` with `paths` (scaled by the effort) paths, seed
-/// `opts.seed + salt`, on `threads` threads.
-pub fn run_method(
-    opts: &FigureOptions,
-    method: Method,
-    scene: &Arc<Scene>,
-    paths: u64,
-    salt: u64,
-    threads: usize,
-) -> Result<RunResult, Error> {
-    figures_common::run_method(opts, method, scene, paths, salt, threads)
-}
-
-/// The file names (`flat_<name>.{png,svg}`) of a figure, saved with its
-/// JSON: what every figure function returns.
-pub(crate) fn save<T: serde::Serialize>(
-    opts: &FigureOptions,
-    name: &str,
-    figure: &crate::plot::Figure,
-    numbers: &T,
-) -> Result<Vec<PathBuf>, Error> {
-    figures_common::save(opts, "flat", name, figure, numbers)
 }

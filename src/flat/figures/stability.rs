@@ -18,13 +18,11 @@
 //! The runs use the paths and the seed of the book's tables and of
 //! `tests/flat_failures.rs`, which pins the first two cases: `4·10⁵` paths
 //! (`2·10⁵` for the slab) and seed 7 for every run (at the default seed 1).
-use super::{FigureOptions, save};
+use super::FigureOptions;
 use crate::error::Error;
-use crate::figures_common::stability::{self, Salt, bias_panel, measure, variance_panel};
-use crate::figures_common::z;
+use crate::figures_common::stability::{self, Case, Salt};
 use crate::flat::Scene;
 use crate::flat::exact::Reference;
-use crate::plot::{Figure, Panel};
 use std::path::PathBuf;
 
 /// Paths per run at effort 1 for the first two cases (the tables' and the
@@ -43,24 +41,21 @@ pub use crate::figures_common::stability::Record;
 
 pub use crate::flat::cases::{knots, sensor_near_edge, thin_slab};
 
-/// The three cases: name, title, axis label, distances, paths, scene
-/// builder.
-type Case = (
-    &'static str,
-    &'static str,
-    &'static str,
-    &'static [f64],
-    u64,
-    fn(f64) -> Result<Scene, Error>,
-);
-const CASES: [Case; 3] = [
+/// `scene` with its analytic `∂E/∂π` where [`Reference`] has one.
+fn with_exact(scene: Scene) -> (Scene, Option<f64>) {
+    let exact = Reference::for_scene(&scene).ok().map(|r| r.derivative(0));
+    (scene, exact)
+}
+
+/// The three cases.
+const CASES: [Case<Scene>; 3] = [
     (
         "knots",
         "two warp knots meeting",
         "gap g between two warp knots",
         &[0.1, 0.03, 0.01, 3e-3, 1e-3, 3e-4, 1e-4],
         PATHS,
-        knots,
+        |g| Ok(with_exact(knots(g)?)),
     ),
     (
         "sensor",
@@ -68,7 +63,7 @@ const CASES: [Case; 3] = [
         "distance d of the sensor to the moving edge",
         &[0.3, 0.1, 0.03, 0.01, 3e-3, 1e-3],
         PATHS,
-        sensor_near_edge,
+        |d| Ok(with_exact(sensor_near_edge(d)?)),
     ),
     (
         "thin",
@@ -76,40 +71,12 @@ const CASES: [Case; 3] = [
         "thickness t of the slab (optical thickness 0.3)",
         &[0.3, 0.1, 0.03, 0.01, 3e-3],
         SLAB_PATHS,
-        thin_slab,
+        |t| Ok(with_exact(thin_slab(t)?)),
     ),
 ];
 
 /// Runs the three cases and writes `flat_stability.{png,svg,json}`.
 pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let builds: Vec<_> = CASES
-        .iter()
-        .map(|&(.., build)| {
-            move |distance: f64| -> Result<(Scene, Option<f64>), Error> {
-                let scene = build(distance)?;
-                let exact = Reference::for_scene(&scene).ok().map(|r| r.derivative(0));
-                Ok((scene, exact))
-            }
-        })
-        .collect();
-    let cases: Vec<stability::Case<'_, Scene>> = CASES
-        .iter()
-        .zip(&builds)
-        .map(|(&(case, _, _, distances, paths, _), build)| (case, distances, paths, build as _))
-        .collect();
-    let records = measure(opts, "flat: stability", &cases, Salt::All(SALT), |e, x| {
-        z(e.mean, e.stderr, x)
-    })?;
-    let mut panels: Vec<Panel> = CASES
-        .iter()
-        .map(|&(case, title, axis, ..)| variance_panel(case, title, axis, "∂E/∂π", &records))
-        .collect();
-    panels.extend(
-        CASES
-            .iter()
-            .map(|&(case, _, axis, ..)| bias_panel(case, axis, "∂E/∂π", &records)),
-    );
-    let mut figure = Figure::new(panels, 3).share_legend();
-    figure.panel_size = (520, 420);
-    save(opts, "stability", &figure, &records)
+    let salt = Salt::All(SALT);
+    stability::figure(opts, "flat", &CASES, salt, "∂E/∂π", (520, 420))
 }

@@ -8,8 +8,9 @@
 //! scene panels draw it as arrows `t V_j(φ) η⊥` at the ends of a fan of
 //! rays, `t` the ray's length: how the ray's end point moves.
 use super::scene::{ViewBox, sensor, shapes, surface_legend};
-use super::{FigureOptions, REFERENCE_COLOR, load, parameter, save};
+use super::{FigureOptions, REFERENCE_COLOR, load, parameter};
 use crate::error::Error;
+use crate::figures_common::save;
 use crate::flat::Scene;
 use crate::flat::geometry::{NO_SEGMENT, direction, perp};
 use crate::flat::methods::sensor_warp;
@@ -287,5 +288,5 @@ pub fn warp(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     }
     let mut figure = Figure::new(panels, 2);
     figure.panel_size = (720, 560);
-    save(opts, "warp", &figure, &warp)
+    save(opts, "flat_warp", &figure, &warp)
 }

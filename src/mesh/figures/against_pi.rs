@@ -16,15 +16,18 @@
 //! triangle's size `r₀(1 + π)`): the estimators differentiate a scale about
 //! the *current* size, `r ∂E/∂r`, so their estimates (and the closed form's)
 //! are divided by `1 + π`.
-use super::{FigureOptions, REFERENCE_COLOR, color, label, save};
+use super::{FigureOptions, REFERENCE_COLOR, color, label};
 use crate::error::Error;
-use crate::figures_common::grid;
-use crate::figures_common::sweep::{self, QUANTITIES, columns, markers};
+use crate::figures_common::save;
+use crate::figures_common::sweep::{self, Column, Exact, Spec};
+use crate::mesh::Scene;
 use crate::mesh::cases::TriangleOccluder;
-use crate::plot::{Figure, Panel, Series};
+use crate::plot::Series;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::Arc;
+
+pub use crate::figures_common::sweep::{Curve, Record, VALUES};
 
 /// One parameter swept over a range.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,9 +56,6 @@ pub const SWEEPS: [Sweep; 3] = [
     },
 ];
 
-/// Values of `π` per sweep (ends included).
-pub const VALUES: usize = 13;
-
 /// Points of the closed-form curves per sweep.
 pub const CURVE_POINTS: usize = 481;
 
@@ -65,107 +65,56 @@ pub const PATHS: u64 = 100_000;
 /// Base of the seed salts of this figure (distinct from the other figures').
 const SALT: u64 = 70_000_000;
 
-pub use crate::figures_common::sweep::Record;
-
-/// The closed-form curve of one sweep.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Curve {
-    /// The parameter.
-    pub parameter: &'static str,
-    /// Values of `π`.
-    pub pi: Vec<f64>,
-    /// `E(π)`.
-    pub e: Vec<f64>,
-    /// `∂E/∂π(π)`.
-    pub de: Vec<f64>,
-}
-
 /// The numbers behind `mesh_against_pi.{png,svg}`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AgainstPi {
     /// The nominal occluder: centre, circumradius, angle of its first
     /// vertex.
     pub occluder: ([f64; 3], f64, f64),
-    /// Every estimate.
-    pub records: Vec<Record>,
-    /// The closed-form curves.
-    pub curves: Vec<Curve>,
+    /// Every estimate and the closed-form curves.
+    #[serde(flatten)]
+    pub sweeps: sweep::AgainstPi,
 }
 
 /// `E` and `∂E/∂π` of the plotted curve at `π` (see the module docs for the
 /// scale), and the factor applied to the estimators' derivative.
-fn exact_at(sweep: &Sweep, pi: f64) -> Result<(f64, f64, f64), Error> {
+fn exact_at(sweep: &Sweep, pi: f64) -> Result<Exact, Error> {
     let k = sweep.parameter;
     let (e, d) = TriangleOccluder::NOMINAL.moved(k, pi).exact()?;
     let factor = if k == 2 { 1.0 / (1.0 + pi) } else { 1.0 };
     Ok((e, d[k] * factor, factor))
 }
 
-/// The sweep's closed-form curve.
-fn curve(sweep: &Sweep) -> Result<Curve, Error> {
-    let (pi, e, de) = sweep::curve(sweep.range, CURVE_POINTS, |p| {
-        exact_at(sweep, p).map(|(v, d, _)| (v, d))
-    })?;
-    Ok(Curve {
-        parameter: TriangleOccluder::PARAMETERS[sweep.parameter],
-        pi,
-        e,
-        de,
-    })
-}
-
-/// Runs every method at every value of `π` of `sweep`.
-fn measure(
-    opts: &FigureOptions,
-    sweep: &Sweep,
-    salt: &mut u64,
-    bar: &indicatif::ProgressBar,
-) -> Result<Vec<Record>, Error> {
-    let k = sweep.parameter;
-    let name = TriangleOccluder::PARAMETERS[k];
-    let values = grid(sweep.range, VALUES);
-    sweep::measure(opts, values, name, PATHS, salt, bar, |pi| {
-        let scene = Arc::new(TriangleOccluder::NOMINAL.moved(k, pi).scene(&[k])?);
-        Ok((scene, exact_at(sweep, pi)?))
-    })
-}
-
-/// Axis label of parameter `k`.
-fn axis(k: usize) -> &'static str {
-    match k {
-        0 => "π = translation along x",
-        1 => "π = rotation about the vertical (rad)",
-        _ => "π = scale − 1",
+impl Column for Sweep {
+    type Scene = Scene;
+    fn parameter(&self) -> &'static str {
+        TriangleOccluder::PARAMETERS[self.parameter]
     }
-}
-
-/// The two panels of one sweep: `E` and `∂E/∂π`, legends off (the figure's
-/// legend has a panel of its own).
-fn panels(sweep: &Sweep, curve: &Curve, records: &[Record]) -> [Panel; 2] {
-    let step = (sweep.range.1 - sweep.range.0) / (VALUES - 1) as f64;
-    QUANTITIES.map(|(quantity, y_label)| {
-        let ys = if quantity == "E" { &curve.e } else { &curve.de };
-        let xy = curve.pi.iter().copied().zip(ys.iter().copied()).collect();
-        let mut series = vec![Series::line("", REFERENCE_COLOR, xy)];
-        series.extend(markers(quantity, step, false, |method| {
-            records
-                .iter()
-                .filter(|r| r.method == method.name() && r.quantity == quantity)
-                .map(|r| (r.pi, r.mean, r.stderr))
-                .collect()
-        }));
-        Panel {
-            title: format!(
-                "triangle occluder: {} against {}",
-                quantity.replace("dE/dπ", "∂E/∂π"),
-                curve.parameter
-            ),
-            x_label: axis(sweep.parameter).into(),
-            y_label: y_label.into(),
-            series,
-            ..Panel::default()
+    fn range(&self) -> (f64, f64) {
+        self.range
+    }
+    fn file(&self) -> Option<&'static str> {
+        None
+    }
+    fn title(&self) -> String {
+        "triangle occluder".into()
+    }
+    fn axis(&self) -> String {
+        match self.parameter {
+            0 => "π = translation along x",
+            1 => "π = rotation about the vertical (rad)",
+            _ => "π = scale − 1",
         }
-    })
+        .into()
+    }
+    fn curve_at(&self, pi: f64) -> Result<(f64, f64), Error> {
+        exact_at(self, pi).map(|(v, d, _)| (v, d))
+    }
+    fn at(&self, pi: f64) -> Result<(Arc<Scene>, Exact), Error> {
+        let k = self.parameter;
+        let scene = Arc::new(TriangleOccluder::NOMINAL.moved(k, pi).scene(&[k])?);
+        Ok((scene, exact_at(self, pi)?))
+    }
 }
 
 /// The figure's legend: the closed form and every method.
@@ -192,33 +141,28 @@ fn legend() -> Vec<Series> {
 /// cargo run --release --example fig_mesh_against_pi -- [OUT_DIR] [EFFORT]
 /// ```
 pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let runs = SWEEPS.len() * VALUES * sweep::methods().count();
-    let bar = opts.bar(runs as u64, "mesh: against π");
-    let mut salt = SALT;
-    let columns = columns(
-        &SWEEPS,
-        curve,
-        |w| measure(opts, w, &mut salt, &bar),
-        panels,
-    )?;
-    bar.finish();
-    let (records, curves, mut top) = (columns.records, columns.curves, columns.top);
-    top.extend(columns.bottom);
-    let mut figure = Figure::new(top, SWEEPS.len());
+    let spec = Spec {
+        prefix: "mesh",
+        curve_points: CURVE_POINTS,
+        paths: PATHS,
+        salt: SALT,
+        legends: false,
+    };
+    let (sweeps, mut figure) = sweep::figure(opts, &spec, &SWEEPS)?;
     figure.legend = legend();
     figure.panel_size = (560, 440);
     let o = TriangleOccluder::NOMINAL;
     let numbers = AgainstPi {
         occluder: (o.centre.to_array(), o.radius, o.angle),
-        records,
-        curves,
+        sweeps,
     };
-    save(opts, "against_pi", &figure, &numbers)
+    save(opts, "mesh_against_pi", &figure, &numbers)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::figures_common::grid;
     use crate::method::Method;
 
     #[test]

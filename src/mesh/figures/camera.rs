@@ -12,12 +12,14 @@
 //! would weigh tens of megabytes. The numbers go to `mesh_camera.json`.
 //!
 //! Book: chapter "Three dimensions", section "A camera".
-use super::{FigureOptions, Scene};
+use super::FigureOptions;
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::image::{ImageResult, render};
 use crate::image_io::{NON_FINITE_RGB, diverging_map, magnitude_map, robust_scale, scale_tag};
+use crate::mesh::Scene;
 use crate::method::{Method, Problem};
+use crate::plot::plot_err;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -117,21 +119,42 @@ struct Run {
     means: Vec<(String, f64, f64)>,
 }
 
-/// Panel side in screen pixels (two per camera pixel at 128 × 128).
-const PANEL: u32 = 256;
-/// Gap between panels.
-const GAP: u32 = 10;
-/// Width of the row labels on the left.
-const LABEL_W: u32 = 124;
-/// Width of the colour bar and its labels on the right.
-const BAR_W: u32 = 92;
-/// Height of the column titles.
-const HEAD_H: u32 = 40;
-/// Height of the caption under each panel.
-const CAPTION_H: u32 = 30;
+/// The grid's geometry, in screen pixels.
+struct Layout {
+    /// Panel side (two per camera pixel at 128 × 128).
+    panel: u32,
+    /// Gap between panels.
+    gap: u32,
+    /// Width of the row labels on the left.
+    label_w: u32,
+    /// Width of the colour bar and its labels on the right.
+    bar_w: u32,
+    /// Height of the column titles.
+    head_h: u32,
+    /// Height of the caption under each panel.
+    caption_h: u32,
+}
 
-fn plot_err<E: std::fmt::Debug>(e: E) -> Error {
-    Error::Output(format!("plotting failed: {e:?}"))
+/// The figure's geometry.
+const LAYOUT: Layout = Layout {
+    panel: 256,
+    gap: 10,
+    label_w: 124,
+    bar_w: 92,
+    head_h: 40,
+    caption_h: 30,
+};
+
+impl Layout {
+    /// Left edge of column `c` (past the last column: the colour bars').
+    fn x(&self, c: u32) -> u32 {
+        self.label_w + c * (self.panel + self.gap)
+    }
+
+    /// Top edge of row `k` (past the last row: the figure's bottom).
+    fn y(&self, k: u32) -> u32 {
+        self.head_h + k * (self.panel + self.caption_h + self.gap)
+    }
 }
 
 /// The display scale of row `q`: [`robust_scale`] of the reference
@@ -152,10 +175,8 @@ pub fn draw(runs: &[ImageResult], path: &Path) -> Result<(), Error> {
     };
     let rows: Vec<Quantity> = first.images.iter().map(|(q, _)| q.clone()).collect();
     let (cols, nrows) = (runs.len() as u32, rows.len() as u32);
-    let size = (
-        LABEL_W + cols * (PANEL + GAP) + BAR_W,
-        HEAD_H + nrows * (PANEL + CAPTION_H + GAP),
-    );
+    let l = &LAYOUT;
+    let size = (l.x(cols) + l.bar_w, l.y(nrows));
     let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(plot_err)?;
     let centre = |size: u32| {
@@ -166,17 +187,17 @@ pub fn draw(runs: &[ImageResult], path: &Path) -> Result<(), Error> {
     };
     let left = |size: u32| ("sans-serif", size).into_font().color(&BLACK);
     for (c, r) in runs.iter().enumerate() {
-        let x = (LABEL_W + c as u32 * (PANEL + GAP) + PANEL / 2) as i32;
+        let x = (l.x(c as u32) + l.panel / 2) as i32;
         let title = if r.method == "fd" {
             "finite differences".to_string()
         } else {
             r.method.to_string()
         };
-        root.draw_text(&title, &centre(22), (x, (HEAD_H / 2) as i32))
+        root.draw_text(&title, &centre(22), (x, (l.head_h / 2) as i32))
             .map_err(plot_err)?;
     }
     for (k, q) in rows.iter().enumerate() {
-        let y0 = HEAD_H + k as u32 * (PANEL + CAPTION_H + GAP);
+        let y0 = l.y(k as u32);
         let intensity = *q == Quantity::Intensity;
         let scale = row_scale(runs, q);
         let map: Box<dyn Fn(f64) -> [u8; 3]> = if intensity {
@@ -184,7 +205,7 @@ pub fn draw(runs: &[ImageResult], path: &Path) -> Result<(), Error> {
         } else {
             Box::new(diverging_map(scale))
         };
-        let mid = (y0 + PANEL / 2) as i32;
+        let mid = (y0 + l.panel / 2) as i32;
         root.draw_text(&row_label(q), &left(22), (8, mid - 24))
             .map_err(plot_err)?;
         let range = if intensity {
@@ -195,9 +216,9 @@ pub fn draw(runs: &[ImageResult], path: &Path) -> Result<(), Error> {
         root.draw_text(&range, &left(16), (8, mid + 6))
             .map_err(plot_err)?;
         for (c, r) in runs.iter().enumerate() {
-            let x0 = LABEL_W + c as u32 * (PANEL + GAP);
-            let area = root.clone().shrink((x0, y0), (PANEL, PANEL));
-            let caption = (x0 + PANEL / 2, y0 + PANEL + CAPTION_H / 2);
+            let x0 = l.x(c as u32);
+            let area = root.clone().shrink((x0, y0), (l.panel, l.panel));
+            let caption = (x0 + l.panel / 2, y0 + l.panel + l.caption_h / 2);
             let caption = (caption.0 as i32, caption.1 as i32);
             match (r.image(q), r.mean(q)) {
                 (Some(img), Some(m)) if r.width == first.width && r.height == first.height => {
@@ -213,7 +234,7 @@ pub fn draw(runs: &[ImageResult], path: &Path) -> Result<(), Error> {
                 }
             }
         }
-        let bx = LABEL_W + cols * (PANEL + GAP);
+        let bx = l.x(cols);
         colour_bar(&root, (bx, y0), intensity, &map, scale)?;
     }
     root.present().map_err(plot_err)
@@ -264,9 +285,10 @@ fn colour_bar<DB: DrawingBackend>(
 ) -> Result<(), Error> {
     const STRIP: u32 = 16;
     let tag = scale_tag(scale);
-    for sy in 0..PANEL {
+    let panel = LAYOUT.panel;
+    for sy in 0..panel {
         // Top is the high end.
-        let t = 1.0 - (f64::from(sy) + 0.5) / f64::from(PANEL);
+        let t = 1.0 - (f64::from(sy) + 0.5) / f64::from(panel);
         let v = if intensity {
             t * scale
         } else {
@@ -294,10 +316,10 @@ fn colour_bar<DB: DrawingBackend>(
     };
     root.draw_text(&top, &style, (lx, (y + 6) as i32))
         .map_err(plot_err)?;
-    root.draw_text(&bottom, &style, (lx, (y + PANEL - 6) as i32))
+    root.draw_text(&bottom, &style, (lx, (y + panel - 6) as i32))
         .map_err(plot_err)?;
     if !intensity {
-        root.draw_text("0", &style, (lx, (y + PANEL / 2) as i32))
+        root.draw_text("0", &style, (lx, (y + panel / 2) as i32))
             .map_err(plot_err)?;
     }
     Ok(())

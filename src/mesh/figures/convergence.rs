@@ -7,9 +7,10 @@
 //! a method gives both). The intensity estimator is judged on `E`, the
 //! others on `∂E/∂π`. A dashed `∝ 1/√N` line is the rate an unbiased
 //! finite-variance estimator shows.
-use super::{FigureOptions, save};
+use super::FigureOptions;
 use crate::error::Error;
 use crate::figures_common::convergence::{measure, panel};
+use crate::figures_common::save;
 use crate::mesh::cases::TriangleOccluder;
 use crate::plot::Figure;
 use std::path::PathBuf;
@@ -41,16 +42,11 @@ pub fn convergence(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         .iter()
         .map(|&k| {
             let parameter = TriangleOccluder::PARAMETERS[k];
-            let rows: Vec<_> = records
-                .iter()
-                .filter(|r| r.parameter == parameter)
-                .map(|r| (r.method, r.paths, r.stderr, r.error))
-                .collect();
             let title = format!("triangle occluder, π = {parameter}: error against paths");
-            panel(title, &rows)
+            panel(title, &records, parameter)
         })
         .collect();
     let mut figure = Figure::new(panels, 2).share_legend();
     figure.panel_size = (760, 560);
-    save(opts, "convergence", &figure, &records)
+    save(opts, "mesh_convergence", &figure, &records)
 }

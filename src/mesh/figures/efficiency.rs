@@ -20,16 +20,13 @@ use crate::mesh::cases::TriangleOccluder;
 use crate::mesh::{Scene, file};
 use std::path::PathBuf;
 
-pub use crate::figures_common::efficiency::Record;
+pub use crate::figures_common::efficiency::{MIN_SECONDS, Record};
 
 /// Panel names: the triangle occluder and two shipped scenes.
 pub const SCENES: [&str; 3] = ["triangle occluder", "cube_shadow.toml", "fog_cube.toml"];
 
 /// Paths per run (times the effort).
 pub const PATHS: u64 = 100_000;
-
-/// Runs shorter than this (seconds) are repeated for a robust time.
-pub const MIN_SECONDS: f64 = 0.1;
 
 /// Most runs of one configuration when timing short runs.
 pub const MAX_REPEATS: u32 = 4;
@@ -60,13 +57,10 @@ pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         prefix: "mesh",
         scenes: &SCENES,
         build: scene,
-        parameters: |scene| scene.parameters().iter().map(|p| p.name.clone()).collect(),
         title: str::to_owned,
         paths: PATHS,
-        min_seconds: MIN_SECONDS,
         max_repeats: MAX_REPEATS,
         salt: SALT,
-        headroom: 2.0,
         panel_size: (1200, 420),
     };
     efficiency::efficiency(opts, &spec)

@@ -23,12 +23,11 @@
 //!
 //! Finite differences are drawn too; their half step (2·10⁻³ of the scene's
 //! size) is larger than some of the distances, where they are biased.
-use super::{FigureOptions, save, z};
+use super::FigureOptions;
 use crate::error::Error;
-use crate::figures_common::stability::{self, Salt, bias_panel, measure, variance_panel};
+use crate::figures_common::stability::{self, Salt};
 use crate::mesh::Scene;
 use crate::mesh::cases::{self, Case};
-use crate::plot::{Figure, Panel};
 use std::path::PathBuf;
 
 /// Paths per run (times the effort).
@@ -42,7 +41,8 @@ const SALT: u64 = 73_000_000;
 /// one exists; `z`: `(mean − exact)/σ`).
 pub use crate::figures_common::stability::Record;
 
-/// One case: name, title, axis label, distances, scene builder.
+/// One case: name, title, axis label, distances, scene builder (every
+/// case runs [`PATHS`] paths).
 type CaseSpec = (
     &'static str,
     &'static str,
@@ -91,23 +91,10 @@ const CASES: [CaseSpec; 4] = [
 /// cargo run --release --example fig_mesh_stability -- [OUT_DIR] [EFFORT]
 /// ```
 pub fn stability(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let cases: Vec<stability::Case<'_, Scene>> = CASES
+    let cases: Vec<stability::Case<Scene>> = CASES
         .iter()
-        .map(|(case, _, _, distances, build)| (*case, *distances, PATHS, build as _))
+        .map(|&(case, title, axis, distances, build)| (case, title, axis, distances, PATHS, build))
         .collect();
-    let records = measure(opts, "mesh: stability", &cases, Salt::Each(SALT), |e, x| {
-        z(e.mean, e.stderr, x)
-    })?;
-    let mut panels: Vec<Panel> = CASES
-        .iter()
-        .map(|&(case, title, axis, _, _)| variance_panel(case, title, axis, "∂E/∂p", &records))
-        .collect();
-    panels.extend(
-        CASES
-            .iter()
-            .map(|&(case, _, axis, _, _)| bias_panel(case, axis, "∂E/∂p", &records)),
-    );
-    let mut figure = Figure::new(panels, CASES.len()).share_legend();
-    figure.panel_size = (480, 420);
-    save(opts, "stability", &figure, &records)
+    let salt = Salt::Each(SALT);
+    stability::figure(opts, "mesh", &cases, salt, "∂E/∂p", (480, 420))
 }

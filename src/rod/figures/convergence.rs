@@ -12,10 +12,14 @@
 use super::{FigureOptions, exact_value, thick, thin};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::plot::{Figure, Panel, Series, spread};
+use crate::figures_common::color;
+use crate::figures_common::convergence::{sigma_and_error, sigma_panel, slope};
+use crate::plot::{Figure, Panel, spread};
 use crate::rod::{Direction, Method, PARAMETER, Rod};
 use serde::Serialize;
 use std::path::PathBuf;
+
+pub use crate::figures_common::convergence::path_counts;
 
 /// The probe position near the moving end `π̃ = 2`.
 pub const NEAR_END: f64 = 1.95;
@@ -33,17 +37,6 @@ pub const PROBES: [(f64, Direction); 4] = [
 /// Base of the seed salts of this figure (distinct from the other figures').
 const SALT: u64 = 10_000_000;
 
-/// Colour of the dashed reference line (black in the palette).
-const REFERENCE_COLOR: usize = 6;
-
-/// Path counts in half decades from `10^lo` to `10^hi`, ends included
-/// (before the effort scaling).
-pub fn path_counts(lo: u32, hi: u32) -> Vec<u64> {
-    (2 * lo..=2 * hi)
-        .map(|k| 10f64.powf(f64::from(k) / 2.0).round() as u64)
-        .collect()
-}
-
 /// What `method` is judged on: `I` for the intensity estimator, `s = ∂I/∂π̃`
 /// for the three sensitivity estimators.
 pub fn judged(method: Method) -> Quantity {
@@ -55,14 +48,10 @@ pub fn judged(method: Method) -> Quantity {
 
 /// Legend label and palette index of `method` in both figures.
 pub(super) fn style(method: Method) -> (String, usize) {
-    let color = match method {
-        Method::Intensity => 0,
-        Method::Expectation => 1,
-        Method::Rendering => 2,
-        Method::Transport => 3,
-        Method::Fd => 4,
-    };
-    (format!("{} ({})", method.name(), judged(method)), color)
+    (
+        format!("{} ({})", method.name(), judged(method)),
+        color(method),
+    )
 }
 
 /// One of the paper's rods at one probe.
@@ -184,7 +173,6 @@ pub(super) fn error_panel(
             continue;
         }
         rs.sort_by(|a, b| x_of(a).total_cmp(&x_of(b)));
-        let (label, color) = style(method);
         let sigma = rs.iter().map(|r| (x_of(r), r.stderr)).collect();
         // The dots side by side: methods that draw the same random numbers
         // give the same error.
@@ -192,13 +180,7 @@ pub(super) fn error_panel(
             .iter()
             .map(|r| (spread(x_of(r), k, n, true, 0.0), r.error.abs(), 0.0))
             .collect();
-        // Transport's σ equals rendering's at most probes: dashed over it.
-        if method == Method::Transport {
-            series.push(Series::dashes(&label, color, sigma));
-        } else {
-            series.push(Series::line(&label, color, sigma));
-        }
-        series.push(Series::points("", color, error));
+        series.extend(sigma_and_error(method, &style(method).0, sigma, error));
     }
     let xs = records.iter().map(x_of);
     let lo = xs.clone().fold(f64::INFINITY, f64::min);
@@ -214,30 +196,9 @@ pub(super) fn error_panel(
         .filter(|r| r.method == anchor_method)
         .max_by(|a, b| x_of(a).total_cmp(&x_of(b)));
     if let Some(a) = anchor {
-        let c = a.stderr * x_of(a).sqrt();
-        series.push(Series::dashed(
-            reference,
-            REFERENCE_COLOR,
-            vec![(lo, c / lo.sqrt()), (hi, c / hi.sqrt())],
-        ));
+        series.push(slope(reference, a.stderr * x_of(a).sqrt(), (lo, hi)));
     }
-    // What lines and dots are, first in the legend (they draw nothing).
-    series.splice(
-        0..0,
-        [
-            Series::line("σ (lines)", REFERENCE_COLOR, vec![]),
-            Series::legend_dot("|mean − exact| (dots)", REFERENCE_COLOR),
-        ],
-    );
-    Panel {
-        title,
-        x_label: x_label.into(),
-        y_label: "σ (lines), |mean − exact| (dots)".into(),
-        x_log: true,
-        y_log: true,
-        series,
-        ..Panel::default()
-    }
+    sigma_panel(title, x_label, series)
 }
 
 /// The convergence figure: σ and |error| against N (10² to 10⁷ paths in

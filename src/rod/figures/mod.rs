@@ -6,8 +6,9 @@
 //! them all.
 use crate::error::Error;
 use crate::estimator::Quantity;
+use crate::figures_common::run_method;
 use crate::rod::{Direction, Method, Probe, Rod, exact};
-use crate::runner::{RunConfig, RunResult, run};
+use crate::runner::RunResult;
 use std::path::PathBuf;
 
 pub mod along;
@@ -32,9 +33,7 @@ impl FigureOptions {
         salt: u64,
     ) -> Result<RunResult, Error> {
         let probe = Probe::new(&rod, x, omega)?;
-        let cfg =
-            RunConfig::new(self.paths(paths), self.seed.wrapping_add(salt))?.threads(self.threads);
-        run(method.estimator((rod, probe))?.as_ref(), &cfg)
+        run_method(self, method, &(rod, probe), paths, salt, self.threads)
     }
 }
 
