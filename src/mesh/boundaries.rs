@@ -58,7 +58,7 @@ use rand::RngExt;
 mod lamp_parts;
 mod strata;
 
-use super::space::LAMP_EDGES;
+use super::edge_sampler::LAMP_EDGES;
 use lamp_parts::{EdgeArc, LAMP_TRIANGLES};
 use strata::{Strata, Stratum};
 
@@ -223,11 +223,11 @@ impl Space {
     fn drawn_tree(&self, x: DVec3, stratum: Stratum) -> (&EdgeTree, bool, [f64; LAMP_EDGES], f64) {
         let tables = self.edge_tables();
         let (tree, cache) = match stratum {
-            Stratum::All => (&tables.all_drawn, &self.sensor_lamps[1]),
-            Stratum::Moving => (&tables.moving_drawn, &self.sensor_lamps[0]),
+            Stratum::All => (&tables.all_drawn, &self.sampler.sensor_lamps[1]),
+            Stratum::Moving => (&tables.moving_drawn, &self.sampler.sensor_lamps[0]),
             Stratum::Shape(k) => (
                 &tables.shape_drawn[k as usize],
-                &self.sensor_shape_lamps[k as usize],
+                &self.sampler.sensor_shape_lamps[k as usize],
             ),
         };
         let apart = tree.edges().len() <= LAMP_EDGES

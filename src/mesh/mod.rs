@@ -20,6 +20,7 @@ pub mod bvh;
 pub mod camera;
 pub mod cases;
 pub mod caveats;
+pub mod edge_sampler;
 pub mod edges;
 pub mod exact;
 #[cfg(feature = "figures")]

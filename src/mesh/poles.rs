@@ -4,7 +4,7 @@
 //! (`super::warp`) builds one fibre field per rule; the space keeps the
 //! rules its parameters use. Book: chapter "Three dimensions", section "A
 //! warp on the sphere".
-use super::scene::Motion;
+use super::scene::{Motion, Scene};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -69,4 +69,74 @@ pub(super) fn pole(x: DVec3) -> DVec3 {
     let phi = 2.0 * PI * next();
     let s = (1.0 - z * z).max(0.0).sqrt();
     DVec3::new(s * phi.cos(), s * phi.sin(), z)
+}
+
+/// A bounding sphere: centre and radius.
+pub(super) type Sphere = (DVec3, f64);
+
+/// A sphere around `points` (their box's centre, the farthest from it),
+/// padded against rounding.
+pub(super) fn bounding_sphere(points: &[DVec3]) -> Sphere {
+    let (lo, hi) = points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &q| (lo.min(q), hi.max(q)),
+    );
+    let c = 0.5 * (lo + hi);
+    let r = points.iter().map(|&q| q.distance(c)).fold(0.0, f64::max);
+    (c, r * (1.0 + 1e-9) + 1e-12 * c.abs().max_element().max(r))
+}
+
+/// A scene's fibre families: the warp's pole rules (distinct, at most
+/// [`MAX_FIELDS`]), per parameter the index of its rule, and per rule the
+/// bounding spheres of the meshes its parameters move; last, those of
+/// every moving mesh (a camera's one family).
+#[derive(Debug, Clone)]
+pub struct PoleTable {
+    pub(super) rules: Vec<PoleRule>,
+    pub(super) slot_field: Vec<u8>,
+    pub(super) field_bounds: Vec<Vec<Sphere>>,
+}
+
+impl PoleTable {
+    /// The families of `scene`'s parameters.
+    pub(super) fn new(scene: &Scene) -> PoleTable {
+        let mut rules = vec![PoleRule::Hashed];
+        let mut slot_field = scene
+            .parameters()
+            .iter()
+            .map(|p| {
+                let rule = PoleRule::of(&p.motion);
+                match rules.iter().position(|r| *r == rule) {
+                    Some(i) => i as u8,
+                    None if rules.len() < MAX_FIELDS => {
+                        rules.push(rule);
+                        (rules.len() - 1) as u8
+                    }
+                    None => 0,
+                }
+            })
+            .collect::<Vec<u8>>();
+        // The pseudo-random family only if some parameter uses it.
+        if !slot_field.contains(&0) && rules.len() > 1 {
+            rules.remove(0);
+            for i in &mut slot_field {
+                *i -= 1;
+            }
+        }
+        let mut field_bounds = vec![Vec::new(); rules.len() + 1];
+        for (j, &f) in slot_field.iter().enumerate() {
+            let k = scene.parameter_shape(j) as usize;
+            let sphere = bounding_sphere(&scene.shapes()[k].vertices);
+            for f in [f as usize, rules.len()] {
+                if !field_bounds[f].contains(&sphere) {
+                    field_bounds[f].push(sphere);
+                }
+            }
+        }
+        PoleTable {
+            rules,
+            slot_field,
+            field_bounds,
+        }
+    }
 }

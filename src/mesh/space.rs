@@ -6,10 +6,10 @@
 //! [`boundaries`](super::boundaries). Book: chapter "Three dimensions".
 use super::bvh::TriangleBvh;
 use super::camera::{CameraFrame, PixelEdges};
+use super::edge_sampler::{EdgeSampler, EdgeTables};
 pub use super::edges::Edge;
-use super::edges::{EdgeFacts, EdgeTree};
 use super::lobe::SpaceLobe;
-use super::poles::{MAX_FIELDS, PoleRule};
+use super::poles::PoleTable;
 use super::scene::{Scene, Sensor as SceneSensor};
 use super::sensor_view::SensorView;
 use crate::path::deform::SlotSet;
@@ -20,13 +20,7 @@ use crate::path::{
 use crate::rng::PathRng;
 use glam::DVec3;
 use rand::RngExt;
-use std::collections::HashMap;
-use std::sync::{Arc, OnceLock};
-
-/// Most edges in a tree for which the edge itself is also drawn by the
-/// length of its arc with a lamp behind (every edge's arc and lamp parts
-/// per draw); larger trees draw by the tree alone.
-pub(super) const LAMP_EDGES: usize = 64;
+use std::sync::Arc;
 
 /// Most edge or vertex touches of media boundaries one cast passes
 /// (`Space::touches_only`) before it reports the next hit as it is.
@@ -50,88 +44,19 @@ pub struct Space {
     /// Emitting triangles with their cumulative area, and the total.
     pub(super) emitters: Vec<(Prim, f64)>,
     emitter_area: f64,
-    /// The edges and their hierarchies, built on first use: only the
-    /// derivative methods ask (not the intensity estimator, nor the
-    /// displaced scenes of finite differences).
-    edge_tables: OnceLock<EdgeTables>,
-    /// A camera sensor's frame, and the moving edges each pixel sees (built
-    /// on first use, by the derivative methods).
+    /// A camera sensor's frame.
     pub(super) camera: Option<CameraFrame>,
-    pixel_edges: OnceLock<PixelEdges>,
-    /// What the sensor's point sees of the edges (built on first use, by
-    /// the expectation method).
-    sensor_view: OnceLock<SensorView>,
-    /// The lamp overlaps (`Space::lamp_overlaps`) of the moving edges and
-    /// of all edges seen from the sensor's point, where every path starts
-    /// (built on first use).
-    pub(super) sensor_lamps: [OnceLock<([f64; LAMP_EDGES], f64)>; 2],
-    /// The same per mesh, for its stratum (`Space::edge_strata`).
-    pub(super) sensor_shape_lamps: Vec<OnceLock<([f64; LAMP_EDGES], f64)>>,
+    /// The edges, and what the derivative methods build of them on first
+    /// use.
+    pub(super) sampler: EdgeSampler,
     /// Per mesh, the parameters that move it.
     pub(super) shape_params: Vec<SlotSet>,
     /// Per mesh holding a medium, a bound on its chords ([`chord_bound`]);
     /// 0 for the others (the walk asks only of media).
     chords: Vec<f64>,
-    /// The warp's pole rules (distinct, at most `MAX_FIELDS`), and per
-    /// parameter the index of its rule.
-    pub(super) pole_rules: Vec<PoleRule>,
-    pub(super) slot_field: Vec<u8>,
-    /// Per pole rule, the bounding spheres of the meshes its parameters
-    /// move; last, those of every moving mesh (a camera's one family).
-    pub(super) field_bounds: Vec<Vec<Sphere>>,
+    /// The warp's fibre families.
+    pub(super) poles: PoleTable,
 }
-
-/// A bounding sphere: centre and radius.
-pub(super) type Sphere = (DVec3, f64);
-
-/// A sphere around `points` (their box's centre, the farthest from it),
-/// padded against rounding.
-fn bounding_sphere(points: &[DVec3]) -> Sphere {
-    let (lo, hi) = points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &q| (lo.min(q), hi.max(q)),
-    );
-    let c = 0.5 * (lo + hi);
-    let r = points.iter().map(|&q| q.distance(c)).fold(0.0, f64::max);
-    (c, r * (1.0 + 1e-9) + 1e-12 * c.abs().max_element().max(r))
-}
-
-/// The edges of the opaque meshes that can be discontinuities, with what
-/// the boundary terms and the warp need of them.
-#[derive(Debug, Clone)]
-pub(super) struct EdgeTables {
-    /// The edges.
-    pub(super) edges: Vec<Edge>,
-    /// Per edge, the weight with which the boundary terms draw it: its
-    /// length times `θ/π` (θ the angle between its faces' normals; 1 for an
-    /// open edge): the share of viewpoints from which it is a silhouette.
-    pub(super) edge_weight: Vec<f64>,
-    /// Per edge, its faces' normals and whether it is a discontinuity
-    /// from everywhere.
-    pub(super) edge_facts: Vec<EdgeFacts>,
-    /// The hierarchy over all edges (the warp's knots).
-    pub(super) all_edges: EdgeTree,
-    /// The lamps' edges (of emitting meshes) when they are at most
-    /// [`LAMP_SET`] and the other edges at most [`LAMP_EDGES`]: every
-    /// boundary term takes each of them
-    /// ([`Space::lamp_edge_points`]): those of moving lamps, then all of
-    /// them (indexed by `all`). Empty otherwise.
-    pub(super) lamp_set: [Vec<u32>; 2],
-    /// The hierarchies the boundary points are drawn from: over all edges
-    /// and over those of moving meshes, without the lamp set's.
-    pub(super) all_drawn: EdgeTree,
-    pub(super) moving_drawn: EdgeTree,
-    /// Per mesh, the hierarchy of its edges without the lamp set's (empty
-    /// for a mesh no parameter moves): a parameter's stratum of the
-    /// boundary term (`Space::edge_strata`).
-    pub(super) shape_drawn: Vec<EdgeTree>,
-    /// Per mesh, its number of edges.
-    pub(super) shape_edges: Vec<u32>,
-}
-
-/// Most lamp edges that every boundary term takes each of, rather than
-/// drawing one among all edges.
-pub(super) const LAMP_SET: usize = 16;
 
 impl Space {
     /// The tables of `scene`.
@@ -169,43 +94,11 @@ impl Space {
                 (i as Prim, emitter_area)
             })
             .collect();
-        let mut pole_rules = vec![PoleRule::Hashed];
-        let mut slot_field = scene
-            .parameters()
-            .iter()
-            .map(|p| {
-                let rule = PoleRule::of(&p.motion);
-                match pole_rules.iter().position(|r| *r == rule) {
-                    Some(i) => i as u8,
-                    None if pole_rules.len() < MAX_FIELDS => {
-                        pole_rules.push(rule);
-                        (pole_rules.len() - 1) as u8
-                    }
-                    None => 0,
-                }
-            })
-            .collect::<Vec<u8>>();
-        // The pseudo-random family only if some parameter uses it.
-        if !slot_field.contains(&0) && pole_rules.len() > 1 {
-            pole_rules.remove(0);
-            for i in &mut slot_field {
-                *i -= 1;
-            }
-        }
         let camera = match scene.sensor() {
             SceneSensor::Camera(c) => Some(c.frame()),
             _ => None,
         };
-        let mut field_bounds = vec![Vec::new(); pole_rules.len() + 1];
-        for (j, &f) in slot_field.iter().enumerate() {
-            let k = scene.parameter_shape(j) as usize;
-            let sphere = bounding_sphere(&scene.shapes()[k].vertices);
-            for f in [f as usize, pole_rules.len()] {
-                if !field_bounds[f].contains(&sphere) {
-                    field_bounds[f].push(sphere);
-                }
-            }
-        }
+        let poles = PoleTable::new(&scene);
         let mut shape_params = vec![SlotSet::EMPTY; scene.shapes().len()];
         for j in 0..scene.parameters().len() {
             shape_params[scene.parameter_shape(j) as usize].insert(j);
@@ -225,16 +118,10 @@ impl Space {
             normals,
             emitters,
             emitter_area,
-            edge_tables: OnceLock::new(),
             camera,
-            pixel_edges: OnceLock::new(),
-            sensor_view: OnceLock::new(),
-            sensor_lamps: [OnceLock::new(), OnceLock::new()],
-            sensor_shape_lamps: (0..shape_params.len()).map(|_| OnceLock::new()).collect(),
+            sampler: EdgeSampler::new(shape_params.len()),
             shape_params,
-            pole_rules,
-            slot_field,
-            field_bounds,
+            poles,
         }
     }
 
@@ -251,7 +138,8 @@ impl Space {
     /// The edge tables, built on first use.
     #[inline]
     pub(super) fn edge_tables(&self) -> &EdgeTables {
-        self.edge_tables
+        self.sampler
+            .tables
             .get_or_init(|| EdgeTables::new(&self.scene, &self.normals))
     }
 
@@ -259,7 +147,7 @@ impl Space {
     /// of the edges, built on first use.
     #[inline]
     pub(super) fn sensor_view(&self) -> &SensorView {
-        self.sensor_view.get_or_init(|| {
+        self.sampler.sensor_view.get_or_init(|| {
             let t = self.edge_tables();
             let opaque: Vec<(Prim, [DVec3; 3])> = (0..self.tris.len())
                 .filter(|&i| {
@@ -271,7 +159,7 @@ impl Space {
                 .collect();
             let point = self.scene.sensor().point();
             // The poles of the warp's fibres at the point: fixed there.
-            let mut poles: Vec<DVec3> = self.pole_rules.iter().map(|r| r.at(point)).collect();
+            let mut poles: Vec<DVec3> = self.poles.rules.iter().map(|r| r.at(point)).collect();
             if let Some(cam) = &self.camera {
                 poles.extend([cam.r, cam.u]);
             }
@@ -284,7 +172,7 @@ impl Space {
     /// (empty without a camera).
     #[inline]
     pub(super) fn pixel_edges(&self) -> &PixelEdges {
-        self.pixel_edges.get_or_init(|| match &self.camera {
+        self.sampler.pixel_edges.get_or_init(|| match &self.camera {
             None => PixelEdges::default(),
             Some(cam) => {
                 let t = self.edge_tables();
@@ -299,140 +187,6 @@ impl Space {
     /// Total area of the emitters.
     pub fn emitter_area(&self) -> f64 {
         self.emitter_area
-    }
-}
-
-impl EdgeTables {
-    /// The edges of `scene`'s opaque meshes (`normals`: per triangle, in
-    /// [`Space`]'s order), their weights and facts, and their hierarchies.
-    fn new(scene: &Scene, normals: &[DVec3]) -> EdgeTables {
-        let mut edges = Vec::new();
-        let mut edge_weight = Vec::new();
-        let mut first = 0u32;
-        for (k, s) in scene.shapes().iter().enumerate() {
-            let first_of_shape = first;
-            first += s.triangles.len() as u32;
-            let first = first_of_shape;
-            if !s.surface.is_opaque() {
-                continue;
-            }
-            // Edges by their vertex pair, in first-seen order (deterministic).
-            let mut index: HashMap<(u32, u32), usize> = HashMap::new();
-            let mut pairs: Vec<((u32, u32), [Prim; 2])> = Vec::new();
-            for (i, t) in s.triangles.iter().enumerate() {
-                for e in 0..3 {
-                    let (a, b) = (t[e], t[(e + 1) % 3]);
-                    let key = (a.min(b), a.max(b));
-                    let p = first + i as u32;
-                    match index.get(&key) {
-                        Some(&m) => {
-                            if pairs[m].1[1] == NO_PRIM {
-                                pairs[m].1[1] = p;
-                            }
-                        }
-                        None => {
-                            index.insert(key, pairs.len());
-                            pairs.push((key, [p, NO_PRIM]));
-                        }
-                    }
-                }
-            }
-            for ((a, b), faces) in pairs {
-                let (a, b) = (s.vertices[a as usize], s.vertices[b as usize]);
-                let turn = if faces[1] == NO_PRIM {
-                    1.0
-                } else {
-                    let (n0, n1) = (normals[faces[0] as usize], normals[faces[1] as usize]);
-                    n0.cross(n1).length().atan2(n0.dot(n1)) / std::f64::consts::PI
-                };
-                let w = (b - a).length() * turn;
-                if w > 0.0 {
-                    edges.push(Edge {
-                        a,
-                        b,
-                        faces,
-                        shape: k as u32,
-                    });
-                    edge_weight.push(w);
-                }
-            }
-        }
-        let params = scene.parameters().len();
-        let moving = |k: u32| (0..params).any(|j| scene.parameter_shape(j) == k);
-        let edge_facts: Vec<EdgeFacts> = edges
-            .iter()
-            .map(|e| {
-                let n0 = normals[e.faces[0] as usize];
-                let open = e.faces[1] == NO_PRIM;
-                let n1 = if open {
-                    n0
-                } else {
-                    normals[e.faces[1] as usize]
-                };
-                let reflector = matches!(
-                    scene.shapes()[e.shape as usize].surface,
-                    Surface::Reflector { .. }
-                );
-                EdgeFacts {
-                    normals: [n0, n1],
-                    always: open || reflector,
-                }
-            })
-            .collect();
-        let all_ids: Vec<u32> = (0..edges.len() as u32).collect();
-        let moving_ids: Vec<u32> = (0..edges.len() as u32)
-            .filter(|&i| moving(edges[i as usize].shape))
-            .collect();
-        let lamp = |i: &u32| {
-            matches!(scene.shapes()[edges[*i as usize].shape as usize].surface,
-                Surface::Emitter { radiance } if radiance > 0.0)
-        };
-        let lamps: Vec<u32> = all_ids.iter().copied().filter(lamp).collect();
-        // Only in small scenes, as the lamp parts (`LAMP_EDGES`): over a
-        // large mesh every point costs casts through a deep hierarchy (on
-        // mesh_perf's sphere of 10^5 triangles transport ran 2.8 times
-        // slower per path for 1.7 times less variance).
-        let lamp_set = if lamps.len() <= LAMP_SET && all_ids.len() - lamps.len() <= LAMP_EDGES {
-            let moving_lamps = moving_ids.iter().copied().filter(lamp).collect();
-            [moving_lamps, lamps]
-        } else {
-            [Vec::new(), Vec::new()]
-        };
-        let drawn = |ids: &[u32]| -> Vec<u32> {
-            ids.iter()
-                .copied()
-                .filter(|i| !lamp_set[1].contains(i))
-                .collect()
-        };
-        let all_drawn = EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&all_ids));
-        let moving_drawn = EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&moving_ids));
-        let shapes = scene.shapes().len();
-        let shape_drawn = (0..shapes as u32)
-            .map(|k| {
-                let ids: Vec<u32> = moving_ids
-                    .iter()
-                    .copied()
-                    .filter(|&i| edges[i as usize].shape == k)
-                    .collect();
-                EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&ids))
-            })
-            .collect();
-        let mut shape_edges = vec![0u32; shapes];
-        for e in &edges {
-            shape_edges[e.shape as usize] += 1;
-        }
-        let all_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, all_ids);
-        EdgeTables {
-            shape_drawn,
-            shape_edges,
-            edges,
-            edge_weight,
-            edge_facts,
-            all_edges,
-            lamp_set,
-            all_drawn,
-            moving_drawn,
-        }
     }
 }
 

@@ -32,8 +32,9 @@
 //! per pole rule ([`PoleRule`](super::poles::PoleRule)), each with its own knot search. Book: chapter "Three dimensions",
 //! section "A warp on the sphere".
 use super::lobe::SpaceLobe;
+use super::poles::Sphere;
 use super::poles::{MAX_FIELDS, pole};
-use super::space::{Space, Sphere};
+use super::space::Space;
 use crate::path::MovingVertex;
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
@@ -142,7 +143,7 @@ impl Space {
         };
         let mut warp = SpaceWarp {
             fields: [blank; MAX_FIELDS],
-            count: self.pole_rules.len(),
+            count: self.poles.rules.len(),
         };
         if let SpaceLobe::Pixel { frame, rect, pixel } = v.lobe {
             // At a camera, one family for every slot: the image's rows
@@ -162,7 +163,7 @@ impl Space {
             warp.count = 1;
             let quiet = frame
                 .is_empty()
-                .then(|| &self.field_bounds[self.pole_rules.len()][..]);
+                .then(|| &self.poles.field_bounds[self.poles.rules.len()][..]);
             warp.fields[0] = self.fibre_field(v, w, pole, ends, quiet);
             return warp;
         }
@@ -173,7 +174,7 @@ impl Space {
         };
         let mut busy = [false; MAX_FIELDS];
         for j in frame.iter() {
-            busy[self.slot_field.get(j).copied().unwrap_or(0) as usize] = true;
+            busy[self.poles.slot_field.get(j).copied().unwrap_or(0) as usize] = true;
         }
         // A fixed pole lays the edges parallel to it along fibres, where V
         // cannot move them across: right while their motion relative to the
@@ -185,11 +186,17 @@ impl Space {
         // ∂I/∂tz 3–6 % off in fog); those families share one field,
         // searched once.
         let mut own: Option<FibreField> = None;
-        for (i, (f, rule)) in warp.fields.iter_mut().zip(&self.pole_rules).enumerate() {
+        for (i, (f, rule)) in warp.fields.iter_mut().zip(&self.poles.rules).enumerate() {
             *f = if busy[i] {
                 *own.get_or_insert_with(|| self.fibre_field(v, w, pole(v.x), ends, None))
             } else {
-                self.fibre_field(v, w, rule.at(v.x), ends, Some(&self.field_bounds[i][..]))
+                self.fibre_field(
+                    v,
+                    w,
+                    rule.at(v.x),
+                    ends,
+                    Some(&self.poles.field_bounds[i][..]),
+                )
             };
         }
         warp
@@ -312,7 +319,7 @@ impl Space {
     ) -> (DVec3, f64) {
         let MovingVertex { x, u, spin } = vertex;
         let rigid = spin.cross(w);
-        let field = self.slot_field.get(slot).copied().unwrap_or(0) as usize;
+        let field = self.poles.slot_field.get(slot).copied().unwrap_or(0) as usize;
         let warp = &warp.fields[field.min(warp.count.saturating_sub(1))];
         if warp.m == DVec3::ZERO {
             return (rigid, 0.0);
@@ -428,8 +435,8 @@ mod tests {
                 let ends = [DVec3::Z, DVec3::ZERO];
                 let field = |quiet: bool| {
                     let mut warp = space.fibre_warp(&v, w, SlotSet::EMPTY);
-                    for (i, rule) in space.pole_rules.iter().enumerate() {
-                        let bounds = quiet.then(|| &space.field_bounds[i][..]);
+                    for (i, rule) in space.poles.rules.iter().enumerate() {
+                        let bounds = quiet.then(|| &space.poles.field_bounds[i][..]);
                         warp.fields[i] = space.fibre_field(&v, w, rule.at(x), ends, bounds);
                     }
                     warp
@@ -451,7 +458,7 @@ mod tests {
                     let f = |warp| space.fibre_velocity(&warp, j, still, w, velocity);
                     let (a, b) = (f(quiet), f(searched));
                     assert_eq!(a, b, "slot {j} at {x} along {w}");
-                    let field = space.slot_field[j] as usize;
+                    let field = space.poles.slot_field[j] as usize;
                     if quiet.fields[field].m == DVec3::ZERO
                         && searched.fields[field].m != DVec3::ZERO
                     {

@@ -3,9 +3,10 @@
 //! silhouette whose arc has a lamp behind it carries direct light across
 //! its jump; those parts are taken apart from the drawn point (book:
 //! chapter "Three dimensions", section "Silhouette edges").
+use super::super::edge_sampler::LAMP_EDGES;
 use super::super::edges::Edge;
 use super::super::edges::{EdgeFacts, EdgeTree};
-use super::super::space::{LAMP_EDGES, Space};
+use super::super::space::Space;
 use crate::path::NO_PRIM;
 use glam::DVec3;
 
