@@ -199,6 +199,12 @@ impl StratumSums {
 /// deviations must lie to be trusted ([`Moments::lost_to_underflow`]).
 const UNDERFLOW_GUARD: f64 = 1048576.0;
 
+/// Relative difference of `Σ|w|` and `nonzero · max|w|` beyond which the
+/// weights' absolute values differ ([`Moments::lost_to_underflow`]): above
+/// the rounding of a sum of equal weights (~10⁻¹⁶ per addition), far below
+/// any real spread of the weights.
+const SAME_WEIGHTS: f64 = 1e-9;
+
 #[inline]
 fn rounding_floor(v: f64) -> f64 {
     if v < 0.0 { 0.0 } else { v }
@@ -288,7 +294,7 @@ impl Moments {
     pub fn lost_to_underflow(&self) -> bool {
         let k = self.nonzero as f64;
         let varies = (self.nonzero > 0 && self.n > self.nonzero)
-            || (self.sum_abs - k * self.max_abs).abs() > 1e-9 * self.sum_abs;
+            || (self.sum_abs - k * self.max_abs).abs() > SAME_WEIGHTS * self.sum_abs;
         varies && self.m2 < UNDERFLOW_GUARD * self.n as f64 * f64::MIN_POSITIVE
     }
 

@@ -236,7 +236,7 @@ impl Boundaries for Plane {
             }
         }
         let rounding = 16.0 * f64::EPSILON * b.q.abs().max_element();
-        let step = (1e-9 * self.scene.size())
+        let step = (crate::path::tolerance::NUDGE * self.scene.size())
             .max(rounding / sin.max(f64::MIN_POSITIVE))
             .min(0.5 * seg.length());
         b.q + along * step

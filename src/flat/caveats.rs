@@ -12,8 +12,8 @@ use crate::estimator::Quantity;
 use crate::method::model::Step;
 
 /// Largest angle (rad) between two corners' sight lines from the sensor
-/// that [`ties`] takes for an alignment: the rounding of an exact one.
-pub const TIE: f64 = 1e-12;
+/// that [`ties`] takes for an alignment (the path core's, shared with 3D).
+pub use crate::path::tolerance::TIE;
 
 /// Where `I` may not be differentiable: two corners in front of an
 /// irradiance sensor (or a camera) lie on one sight line, within [`TIE`]

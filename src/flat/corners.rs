@@ -66,7 +66,7 @@ impl CornerTree {
         // Boxes are padded far beyond the rounding of the separation tests
         // (cross products, relative error ~1e-16), so a corner inside a
         // triangle is never culled with its box.
-        let pad = 1e-9
+        let pad = crate::path::tolerance::CULL_PAD
             * (hi - lo)
                 .max_element()
                 .max(lo.abs().max(hi.abs()).max_element());

@@ -195,11 +195,12 @@ fn cross(u: DVec2, v: DVec2) -> f64 {
     u.perp_dot(v)
 }
 
-/// Whether `q` lies on the segment `[a, b]` (relative tolerance 1e-12).
+/// Whether `q` lies on the segment `[a, b]` (relative tolerance
+/// [`COINCIDENT`](crate::path::tolerance::COINCIDENT)).
 fn on_segment(q: DVec2, a: DVec2, b: DVec2) -> bool {
     let e = b - a;
     let s = ((q - a).dot(e) / e.length_squared()).clamp(0.0, 1.0);
-    (a + s * e - q).length() <= 1e-12 * (e.length() + (q - a).length())
+    (a + s * e - q).length() <= crate::path::tolerance::COINCIDENT * (e.length() + (q - a).length())
 }
 
 /// Whether the closed segments `[p1, p2]` and `[q1, q2]` share a point.
@@ -303,7 +304,7 @@ impl OccludedIrradiance {
         )?;
         let (a, b) = (emitter.a, emitter.b);
         let scale = (b - a).length() * ((b - a).length() + (p - a).length());
-        if cross(b - a, p - a).abs() <= 1e-12 * scale {
+        if cross(b - a, p - a).abs() <= crate::path::tolerance::COINCIDENT * scale {
             return Err(Error::Config(
                 "the sensor lies on the emitter's line".into(),
             ));

@@ -87,10 +87,10 @@ impl Segment {
 }
 
 /// Smallest ray distance counted as a hit, relative to the length of the
-/// segment hit: a ray leaving a surface (or a corner) must not find the
-/// surface it leaves (the tracer also skips that segment by id). Relative,
-/// so a scene scaled by any factor validation accepts traces the same.
-pub const T_MIN: f64 = 1e-12;
+/// segment hit (the path core's, shared with 3D): a ray leaving a surface
+/// (or a corner) must not find the surface it leaves (the tracer also
+/// skips that segment by id).
+pub use crate::path::tolerance::T_MIN;
 
 /// Twice the signed area of the triangle `a b c` (> 0 counter-clockwise).
 #[inline]

@@ -78,11 +78,11 @@ pub use crate::bvh_frame::PAD;
 use crate::bvh_frame::{Primitive, Tree, scan_any, scan_closest};
 
 /// Smallest ray distance counted as a hit, relative to the longest edge of
-/// the triangle hit (and to the size of the ray direction): as flatland's
-/// [`geometry::T_MIN`](crate::flat::geometry::T_MIN), a ray leaving a
-/// surface must not find the triangles around its origin, and the
-/// threshold scales with the scene.
-pub const T_MIN: f64 = 1e-12;
+/// the triangle hit (and to the size of the ray direction; the path
+/// core's, shared with flatland): a ray leaving a surface must not find
+/// the triangles around its origin, and the threshold scales with the
+/// scene.
+pub use crate::path::tolerance::T_MIN;
 
 /// Ulps of a triangle's largest coordinate below which a hit is the
 /// rounding of a point on it, not a hit ([`T_MIN`] for triangles far

@@ -280,7 +280,7 @@ impl EdgeTree {
         let sin_s = sin_b * n.cos_half + cos_b * n.sin_half;
         let cos_phi = (r / d).dot(n.axis).clamp(-1.0, 1.0);
         let sin_phi = (1.0 - cos_phi * cos_phi).max(0.0).sqrt();
-        let margin = 1e-9;
+        let margin = crate::path::tolerance::CULL_PAD;
         let front = cos_phi * cos_s - sin_phi * sin_s > margin;
         let back = cos_phi * cos_s + sin_phi * sin_s < -margin;
         !(front || back)
@@ -419,7 +419,10 @@ impl EdgeTree {
             let n = &self.nodes[i];
             let c = 0.5 * (n.lo + n.hi);
             let h = 0.5 * (n.hi - n.lo);
-            let reach = |v: DVec3| (c - x).dot(v).abs() <= h.dot(v.abs()) * (1.0 + 1e-12) + 1e-300;
+            let reach = |v: DVec3| {
+                (c - x).dot(v).abs()
+                    <= h.dot(v.abs()) * (1.0 + crate::path::tolerance::COORDINATE_PAD) + 1e-300
+            };
             let ahead = (c - x).dot(side) + h.dot(side.abs()) >= 0.0;
             if !reach(m) || !ahead || !self.open(i, x) {
                 continue;

@@ -251,7 +251,7 @@ fn check_polygon(name: &'static str, x: DVec3, poly: &[DVec3]) -> Result<(), Err
         };
         let dist = (a + t * e - x).length();
         let scale = (a - x).length().max((b - x).length());
-        if dist <= 1e-12 * scale || scale == 0.0 {
+        if dist <= crate::path::tolerance::COINCIDENT * scale || scale == 0.0 {
             return scene_error("the sensor lies on an edge or vertex of a polygon");
         }
     }
@@ -315,12 +315,15 @@ fn lamp_plane(lamp: &[DVec3]) -> Result<(DVec3, f64), Error> {
         .iter()
         .map(|&p| (p - lamp[0]).length())
         .fold(0.0, f64::max);
-    if newell.length() <= 1e-12 * size * size {
+    if newell.length() <= crate::path::tolerance::DEGENERATE * size * size {
         return scene_error("the lamp has no area");
     }
     let nn = newell.normalize();
     let c = nn.dot(lamp[0]);
-    if lamp.iter().any(|&p| (nn.dot(p) - c).abs() > 1e-9 * size) {
+    if lamp
+        .iter()
+        .any(|&p| (nn.dot(p) - c).abs() > crate::path::tolerance::ON_SURFACE * size)
+    {
         return scene_error("the lamp is not planar");
     }
     Ok((nn, c))
@@ -412,7 +415,7 @@ fn occluded(
         .try_for_each(|&q| finite_point("occluder vertex", q))?;
     let k = c - nn.dot(x);
     let size = lamp.iter().map(|&p| (p - x).length()).fold(0.0, f64::max);
-    if k.abs() <= 1e-12 * size {
+    if k.abs() <= crate::path::tolerance::COINCIDENT * size {
         return scene_error("the sensor lies in the lamp's plane");
     }
     // Central projection onto the lamp's plane, with its Jacobian.
@@ -421,7 +424,8 @@ fn occluded(
         let r = q - x;
         let s = nn.dot(r);
         let lambda = s / k;
-        if !(lambda > 1e-12 && lambda < 1.0 - 1e-12) {
+        use crate::path::tolerance::COINCIDENT;
+        if !(lambda > COINCIDENT && lambda < 1.0 - COINCIDENT) {
             return scene_error(
                 "the occluder must lie strictly between the sensor and the lamp's plane",
             );

@@ -83,7 +83,11 @@ pub(super) fn bounding_sphere(points: &[DVec3]) -> Sphere {
     );
     let c = 0.5 * (lo + hi);
     let r = points.iter().map(|&q| q.distance(c)).fold(0.0, f64::max);
-    (c, r * (1.0 + 1e-9) + 1e-12 * c.abs().max_element().max(r))
+    use crate::path::tolerance::{COORDINATE_PAD, CULL_PAD};
+    (
+        c,
+        r * (1.0 + CULL_PAD) + COORDINATE_PAD * c.abs().max_element().max(r),
+    )
 }
 
 /// A scene's fibre families: the warp's pole rules (distinct, at most

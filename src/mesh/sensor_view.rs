@@ -118,7 +118,7 @@ impl AzimuthBuckets {
             };
             let (cx, cy) = (ax + t * dx, ay + t * dy);
             let size = (ax.hypot(ay)).max(bx.hypot(by));
-            if cx.hypot(cy) <= 1e-9 * size || size == 0.0 {
+            if cx.hypot(cy) <= crate::path::tolerance::NEAR * size || size == 0.0 {
                 lists.iter_mut().for_each(|l| l.push(i));
                 continue;
             }

@@ -179,7 +179,13 @@ impl Space {
                 let params = self.scene.parameters().len();
                 let moving = |k: u32| (0..params).any(|j| self.scene.parameter_shape(j) == k);
                 let ids = (0..t.edges.len() as u32).filter(|&i| moving(t.edges[i as usize].shape));
-                PixelEdges::new(cam, &t.edges, &t.edge_facts, ids, 1e-9 * self.scene.size())
+                PixelEdges::new(
+                    cam,
+                    &t.edges,
+                    &t.edge_facts,
+                    ids,
+                    crate::path::tolerance::ON_SURFACE * self.scene.size(),
+                )
             }
         })
     }
@@ -252,7 +258,12 @@ impl Geometry for Space {
         } else {
             self.opaque_index[skip as usize]
         };
-        !self.opaque.any_hit(x, d / len, len * (1.0 - 1e-9), skip)
+        !self.opaque.any_hit(
+            x,
+            d / len,
+            len * (1.0 - crate::path::tolerance::SHORT_OF_END),
+            skip,
+        )
     }
     #[inline]
     fn shape(&self, p: Prim) -> u32 {
@@ -273,7 +284,7 @@ impl Geometry for Space {
         // the surface it left is then skipped only at grazing angles.
         // Within 70 sizes of the origin this is 10⁻⁹ of the size.
         let floor = super::bvh::ROUNDING_ULPS * f64::EPSILON * y.abs().max_element();
-        (1e-9 * self.scene.size()).max(1e3 * floor)
+        (crate::path::tolerance::NUDGE * self.scene.size()).max(1e3 * floor)
     }
     #[inline]
     fn solid(&self, p: Prim) -> bool {

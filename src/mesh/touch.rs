@@ -24,11 +24,11 @@ use glam::DVec3;
 /// vertex test's `g` (any direction off the fan's projected edges serves).
 const GENERIC: DVec3 = DVec3::new(0.574_145_230_8, 0.219_374_818_2, 0.788_870_133_1);
 
-/// How near an edge function must be to 0, relative to the three's sum,
-/// for a hit to count as on the edge (rounding puts a ray through an edge
-/// ~1e-16 to either side; a hit this near an edge whose two faces lie on
-/// one side is passed only if the cast that follows misses the other).
-const NEAR: f64 = 1e-9;
+// How near an edge function must be to 0, relative to the three's sum,
+// for a hit to count as on the edge: the path core's `NEAR` (a hit this
+// near an edge whose two faces lie on one side is passed only if the cast
+// that follows misses the other).
+use crate::path::tolerance::NEAR;
 
 impl Space {
     /// Whether the ray from `x` along `w`, which hits triangle `prim` of a

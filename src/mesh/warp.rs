@@ -222,7 +222,7 @@ impl Space {
         let perp = w - p * c;
         let s = perp.length();
         let still = |cos: f64| FibreKnot { cos, edge: None };
-        if s < 1e-12 {
+        if s < crate::path::tolerance::TIE {
             // η at a pole: the field is the frame's there.
             return FibreField {
                 m: DVec3::ZERO,
@@ -256,7 +256,7 @@ impl Space {
         for n in ends {
             let h = n.cross(m);
             let len = h.length();
-            if len > 1e-12 {
+            if len > crate::path::tolerance::TIE {
                 let h = if h.dot(u) < 0.0 { -h / len } else { h / len };
                 let ch = h.dot(p);
                 if ch > c && ch < lo.cos {

@@ -31,6 +31,7 @@ pub mod intensity;
 pub mod nested;
 pub mod rendering;
 pub mod thin_media;
+pub mod tolerance;
 pub mod transport;
 pub mod walk;
 
@@ -270,14 +271,17 @@ pub trait Geometry: Sync {
     /// shapes).
     fn normal(&self, p: Prim, y: Self::V) -> Self::V;
     /// How far off a surface, an interface or a boundary point at `y` a
-    /// nested path starts: 10⁻⁹ of the scene's size, and far from the
-    /// origin (3D) enough more that the casters, which skip hits within
-    /// the rounding of their coordinates, still see the surface it left
-    /// (at 10⁵ sizes from the origin a moving fog's derivative was 4× off
-    /// with the fixed step).
+    /// nested path starts: [`tolerance::NUDGE`] of the scene's size, and far
+    /// from the origin (3D) enough more that the casters, which skip hits
+    /// within the rounding of their coordinates, still see the surface it
+    /// left (at 10⁵ sizes from the origin a moving fog's derivative was 4×
+    /// off with the fixed step, and at 4·10⁵ transport's derivative for a
+    /// mirror moving inside fog +1.4e-2 against −2.5e-3 at the origin,
+    /// while its in-scattering start took a fixed half step). Every start
+    /// a hair off a surface goes through here.
     #[inline]
     fn nudge(&self, _y: Self::V) -> f64 {
-        1e-9 * self.size()
+        tolerance::NUDGE * self.size()
     }
     /// Whether primitive `p` bounds a solid no path reaches the inside of:
     /// flatland's closed opaque polygons, 3D's closed opaque meshes the

@@ -121,7 +121,7 @@ impl<G: Boundaries> Transport<'_, G> {
             Some(Coefficients { ks, .. }) if ks > 0.0 => match walk.scratch.work.admit(rng) {
                 Some(weight) => {
                     let ray = Ray {
-                        x: v.x - w * (0.5e-9 * g.size()),
+                        x: v.x - w * (0.5 * g.nudge(v.x)),
                         w: super::Lobe::sample(&g.phase_lobe(medium, w), rng),
                         medium,
                         skip: NO_PRIM,

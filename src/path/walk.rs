@@ -506,7 +506,7 @@ pub fn reach<G: Geometry>(
     loop {
         let ke = g.coefficients(medium).map_or(0.0, |c| c.ke);
         match g.cast(x, w, skip) {
-            Some(h) if h.t < left * (1.0 - 1e-9) => {
+            Some(h) if h.t < left * (1.0 - super::tolerance::SHORT_OF_END) => {
                 let opaque = g.surface(h.prim) != Surface::Transparent;
                 if opaque && !(passes < HOLDING_PASSES && holds(h.prim)) {
                     return None;

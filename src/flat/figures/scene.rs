@@ -365,7 +365,7 @@ fn moving(scene: &Scene, k: u32) -> bool {
 
 /// The path vertices lying on a segment of a moving shape.
 fn moving_hits(scene: &Scene, paths: &[PathRecord]) -> Vec<[f64; 2]> {
-    let tol = 1e-9 * scene.size();
+    let tol = crate::path::tolerance::ON_SURFACE * scene.size();
     let segments: Vec<_> = (0..scene.segments().len() as u32)
         .filter(|&i| moving(scene, scene.owner(i)))
         .map(|i| scene.segments()[i as usize])

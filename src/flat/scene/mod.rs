@@ -317,7 +317,12 @@ impl Scene {
         } else {
             self.opaque_index[skip as usize]
         };
-        !self.opaque.any_hit(from, d / len, len * (1.0 - 1e-9), skip)
+        !self.opaque.any_hit(
+            from,
+            d / len,
+            len * (1.0 - crate::path::tolerance::SHORT_OF_END),
+            skip,
+        )
     }
     /// Whether corner `i` is seen from `from`: [`Self::visible`], except
     /// that the corner's own segments do not hide it. A ray aimed at a
@@ -336,7 +341,7 @@ impl Scene {
         let (mut x, mut left, mut skip, mut passes) = (from, len, skip, 0);
         loop {
             match self.cast(x, w, skip) {
-                Some(h) if h.t < left * (1.0 - 1e-9) => {
+                Some(h) if h.t < left * (1.0 - crate::path::tolerance::SHORT_OF_END) => {
                     let seg = self.segments[h.segment as usize];
                     let own = seg.a == q || seg.b == q;
                     let passes_left = passes < crate::path::walk::HOLDING_PASSES;

@@ -11,9 +11,9 @@ use super::Scene;
 use super::Surface;
 use glam::DVec2;
 
-/// How near a segment's end, relative to its length, a hit counts as at
-/// the vertex (rounding puts a ray through a vertex ~1e-16 to either side).
-const NEAR: f64 = 1e-9;
+// How near a segment's end, relative to its length, a hit counts as at
+// the vertex: the path core's `NEAR`.
+use crate::path::tolerance::NEAR;
 
 /// Most touches one cast passes before it reports the next hit as it is.
 const MAX_TOUCHES: usize = 8;

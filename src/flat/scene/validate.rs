@@ -174,11 +174,13 @@ fn outline(shapes: &[Shape], size: f64) -> Result<Outline, Error> {
     let mut normal = Vec::new();
     for (k, s) in shapes.iter().enumerate() {
         let ccw = s.closed && signed_area(&s.vertices) > 0.0;
-        if s.closed && signed_area(&s.vertices).abs() <= 1e-12 * size * size {
+        if s.closed
+            && signed_area(&s.vertices).abs() <= crate::path::tolerance::DEGENERATE * size * size
+        {
             return config(format!("shape {:?} encloses no area", s.name));
         }
         for (i, seg) in s.segments().enumerate() {
-            if seg.length() <= 1e-12 * size {
+            if seg.length() <= crate::path::tolerance::DEGENERATE * size {
                 return config(format!("shape {:?}: segment {i} has zero length", s.name));
             }
             let left = seg.left_normal();
@@ -325,7 +327,7 @@ fn check_sensor(
     };
     let p = sensor.point();
     for (i, seg) in segments.iter().enumerate() {
-        if seg.distance(p) <= 1e-9 * size {
+        if seg.distance(p) <= crate::path::tolerance::ON_SURFACE * size {
             return config(format!(
                 "the sensor at [{}, {}] lies on shape {:?}",
                 Num(p.x),

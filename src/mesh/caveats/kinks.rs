@@ -59,14 +59,22 @@ fn edge_on_plane(
         .iter()
         .map(|q| q.abs().max_element())
         .fold(x.abs().max_element(), f64::max);
-    let tolerance = (1e-9 * scene.size()).max(EDGE_ON_ULPS * f64::EPSILON * reach);
+    let tolerance = (crate::path::tolerance::ON_SURFACE * scene.size())
+        .max(EDGE_ON_ULPS * f64::EPSILON * reach);
     let off = n.dot(x - t[0]);
     (n != glam::DVec3::ZERO && off.abs() <= tolerance).then_some((n, off, tolerance))
 }
 
+/// Largest angle (rad) between a velocity and a plane at which the motion
+/// stays in the plane (see [`crosses`]): wider than an alignment's
+/// [`TIE`](crate::path::tolerance::TIE), for a rotation's velocity about a
+/// pivot up to `MAX_OFFSET` sizes away keeps fewer digits than a
+/// coordinate.
+const IN_PLANE: f64 = 1e-9;
+
 /// Whether a motion at velocity `v` leaves the plane of unit normal `n`.
 pub(super) fn crosses(v: glam::DVec3, n: glam::DVec3) -> bool {
-    v.dot(n).abs() > 1e-9 * v.length()
+    v.dot(n).abs() > IN_PLANE * v.length()
 }
 
 /// Where the sensor's gradient may not exist: the sensor lies in the plane

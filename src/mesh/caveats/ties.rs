@@ -9,9 +9,9 @@ use crate::mesh::space::Space;
 use std::f64::consts::{PI, TAU};
 
 /// Largest relative distance of an edge's ends from the plane through the
-/// sensor and another edge that [`edge_ties`] takes for an alignment: the
-/// rounding of an exact one.
-pub const TIE: f64 = 1e-12;
+/// sensor and another edge that [`edge_ties`] takes for an alignment (the
+/// path core's, shared with flatland).
+pub use crate::path::tolerance::TIE;
 
 /// Where `I` may not be differentiable: an edge of a moved mesh and an edge
 /// of another mesh (both discontinuities seen from the sensor) lie in one

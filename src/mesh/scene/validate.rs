@@ -35,11 +35,11 @@ use std::collections::{HashMap, HashSet};
 /// diagonal of its mesh's bounding box, is degenerate (a sliver the tracer
 /// could not give a normal to). The same factor times `d³` is the least
 /// volume a closed mesh must enclose.
-pub const DEGENERATE_AREA: f64 = 1e-12;
+pub const DEGENERATE_AREA: f64 = crate::path::tolerance::DEGENERATE;
 
 /// A sensor closer than `SENSOR_DISTANCE × size` to a triangle lies on it
 /// (flatland's rule).
-const SENSOR_DISTANCE: f64 = 1e-9;
+const SENSOR_DISTANCE: f64 = crate::path::tolerance::ON_SURFACE;
 
 fn show(p: DVec3) -> String {
     format!("[{}, {}, {}]", Num(p.x), Num(p.y), Num(p.z))
