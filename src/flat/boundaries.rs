@@ -7,11 +7,10 @@
 //! "Corner jumps" and "The warp field".
 use super::geometry::{NO_SEGMENT, cross, perp};
 use super::lobe::FlatLobe;
-use super::scene::{Phase, Sensor as FlatSensor};
 use super::space::{Knot, Plane};
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, NO_PRIM, Side};
+use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, Side};
 use glam::DVec2;
 use std::f64::consts::TAU;
 
@@ -545,67 +544,6 @@ fn knot(x: DVec2, w: DVec2, (q, k): (DVec2, u32), ccw: bool) -> Knot {
         a += TAU;
     }
     (a, q, k)
-}
-
-/// The warp field at the sensor for figures: `V_j(φ)` (rad per unit of
-/// parameter `j`) of the looking direction at angle `phi` from +x. For an
-/// irradiance sensor, directions behind it get 0 (the field is pinned to the
-/// frame at the horizons).
-pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
-    let scene = &plane.scene;
-    let n = scene.parameters().len();
-    let w = super::geometry::direction(phi);
-    let (x, lobe, at_sensor) = match scene.sensor() {
-        FlatSensor::Irradiance { point, normal } => {
-            if w.dot(normal) <= 0.0 {
-                return vec![0.0; n];
-            }
-            (point, FlatLobe::Cosine { n: normal, c: 1.0 }, true)
-        }
-        FlatSensor::Radiance { point, direction }
-        | FlatSensor::Camera {
-            position: point,
-            direction,
-            ..
-        } => (
-            point,
-            FlatLobe::Phase {
-                phase: Phase::Isotropic,
-                w_in: direction,
-            },
-            false,
-        ),
-    };
-    let v = Vertex {
-        x,
-        medium: scene.sensor_medium(),
-        skip: NO_PRIM,
-        lobe,
-        w_in: w,
-        frame: crate::path::walk::Frame::Sensor,
-        beta: 1.0,
-        at_sensor,
-        mixed: false,
-    };
-    let field = plane.warp(&v, w, None, SlotSet::EMPTY);
-    (0..n)
-        .map(|j| {
-            let velocity = |q: DVec2, k: u32| {
-                if scene.parameter_shape(j) == k {
-                    scene.parameters()[j].motion.velocity(q)
-                } else {
-                    DVec2::ZERO
-                }
-            };
-            let still = MovingVertex {
-                x,
-                u: DVec2::ZERO,
-                spin: 0.0,
-            };
-            let (wd, _) = plane.warp_velocity(&field, 0, still, w, velocity);
-            wd.dot(perp(w))
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -17,15 +17,21 @@
 //! scene ([`Model`]).
 pub use super::caveats::ties;
 use super::caveats::view_change;
+use super::geometry::{direction, perp};
+use super::lobe::FlatLobe;
+use super::scene::Phase;
 use super::scene::{Motion, Scene, Sensor};
 use super::space::Plane;
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::fd::CentralDifference;
 use crate::method::model::{self, Model, Step};
-use crate::path::Surface;
+use crate::path::deform::SlotSet;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::thin_media::chord_bound;
+use crate::path::walk::{Frame, Vertex};
+use crate::path::{Boundaries, MovingVertex, NO_PRIM, Surface};
+use glam::DVec2;
 use std::sync::Arc;
 
 pub use super::caveats::TIE;
@@ -108,10 +114,63 @@ pub fn finite_difference(scene: &Arc<Scene>, step: f64) -> Result<CentralDiffere
     model::finite_difference(scene, step)
 }
 
-/// The expectation method's warp field at the sensor: `V_j(φ)` (rad per
-/// unit of parameter `j`) of the looking direction at angle `phi` from +x,
-/// for every parameter. For an irradiance sensor, directions behind it get
-/// 0 (the field is pinned to the frame at the horizons).
+/// The expectation method's warp field at the sensor, for figures: `V_j(φ)` (rad per unit of
+/// parameter `j`) of the looking direction at angle `phi` from +x. For an
+/// irradiance sensor, directions behind it get 0 (the field is pinned to the
+/// frame at the horizons).
 pub fn sensor_warp(plane: &Plane, phi: f64) -> Vec<f64> {
-    super::boundaries::sensor_warp(plane, phi)
+    let scene = plane.scene();
+    let n = scene.parameters().len();
+    let w = direction(phi);
+    let (x, lobe, at_sensor) = match scene.sensor() {
+        Sensor::Irradiance { point, normal } => {
+            if w.dot(normal) <= 0.0 {
+                return vec![0.0; n];
+            }
+            (point, FlatLobe::Cosine { n: normal, c: 1.0 }, true)
+        }
+        Sensor::Radiance { point, direction }
+        | Sensor::Camera {
+            position: point,
+            direction,
+            ..
+        } => (
+            point,
+            FlatLobe::Phase {
+                phase: Phase::Isotropic,
+                w_in: direction,
+            },
+            false,
+        ),
+    };
+    let v = Vertex {
+        x,
+        medium: scene.sensor_medium(),
+        skip: NO_PRIM,
+        lobe,
+        w_in: w,
+        frame: Frame::Sensor,
+        beta: 1.0,
+        at_sensor,
+        mixed: false,
+    };
+    let field = plane.warp(&v, w, None, SlotSet::EMPTY);
+    (0..n)
+        .map(|j| {
+            let velocity = |q: DVec2, k: u32| {
+                if scene.parameter_shape(j) == k {
+                    scene.parameters()[j].motion.velocity(q)
+                } else {
+                    DVec2::ZERO
+                }
+            };
+            let still = MovingVertex {
+                x,
+                u: DVec2::ZERO,
+                spin: 0.0,
+            };
+            let (wd, _) = plane.warp_velocity(&field, 0, still, w, velocity);
+            wd.dot(perp(w))
+        })
+        .collect()
 }

@@ -1,5 +1,5 @@
 use super::*;
-use crate::flat::scene::{Scene, Shape, Surface};
+use crate::flat::scene::{Scene, Sensor as FlatSensor, Shape, Surface};
 use rand::{RngExt, SeedableRng};
 use std::f64::consts::PI;
 use std::sync::Arc;

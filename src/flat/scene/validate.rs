@@ -383,13 +383,18 @@ fn nest_media(shapes: &[Shape], p: DVec2) -> (Vec<Option<u32>>, Option<u32>) {
             }
         })
         .collect();
+    // Only the media are candidates: every shape asks, so a scan of all
+    // shapes per shape was quadratic (10⁵ shapes: 40 s).
+    let media: Vec<usize> = (0..shapes.len())
+        .filter(|&k| shapes[k].medium.is_some())
+        .collect();
     let medium_at = |q: DVec2, except: Option<usize>| -> Option<u32> {
-        shapes
+        media
             .iter()
-            .enumerate()
-            .filter(|&(k, s)| Some(k) != except && s.medium.is_some() && contains(&s.vertices, q))
-            .min_by(|a, b| area[a.0].total_cmp(&area[b.0]))
-            .map(|(k, _)| k as u32)
+            .copied()
+            .filter(|&k| Some(k) != except && contains(&shapes[k].vertices, q))
+            .min_by(|&a, &b| area[a].total_cmp(&area[b]))
+            .map(|k| k as u32)
     };
     let parent = shapes
         .iter()

@@ -462,13 +462,18 @@ fn nest_media(
     volume: &[f64],
     p: DVec3,
 ) -> (Vec<Option<u32>>, Option<u32>) {
+    // Only the closed media are candidates: every mesh asks, so a scan of
+    // all meshes per mesh was quadratic.
+    let media: Vec<usize> = (0..shapes.len())
+        .filter(|&k| shapes[k].medium.is_some() && closed[k])
+        .collect();
     let medium_at = |q: DVec3, except: Option<usize>| -> Option<u32> {
-        shapes
+        media
             .iter()
-            .enumerate()
-            .filter(|&(k, s)| Some(k) != except && s.medium.is_some() && closed[k] && inside(s, q))
-            .min_by(|a, b| volume[a.0].total_cmp(&volume[b.0]))
-            .map(|(k, _)| k as u32)
+            .copied()
+            .filter(|&k| Some(k) != except && inside(&shapes[k], q))
+            .min_by(|&a, &b| volume[a].total_cmp(&volume[b]))
+            .map(|k| k as u32)
     };
     let parent = shapes
         .iter()
