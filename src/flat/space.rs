@@ -8,7 +8,7 @@ use super::geometry::{NO_SEGMENT, cross};
 use super::lobe::FlatLobe;
 use super::scene::{Phase, Scene, Sensor as FlatSensor};
 use crate::path::deform::SlotSet;
-use crate::path::thin_media::chord_bound;
+use crate::path::media::Media;
 use crate::path::{Coefficients, Geometry, Hit, MediumId, PixelSample, Prim, Sensor, Surface};
 use crate::rng::PathRng;
 use glam::DVec2;
@@ -38,9 +38,8 @@ pub struct Plane {
     pub(super) shape_corners: Vec<(u32, u32)>,
     /// Per shape, the parameters that move it.
     pub(super) shape_params: Vec<SlotSet>,
-    /// Per shape holding a medium, a bound on its chords ([`chord_bound`]);
-    /// 0 for the others (the walk asks only of media).
-    chords: Vec<f64>,
+    /// The media, for the walk.
+    media: Media,
     /// The shapes some parameter moves whose corners weigh (> 0).
     pub(super) weighed_shapes: Vec<u32>,
     /// Every parameter's slot, and for that view the parameters with a
@@ -166,13 +165,12 @@ impl Plane {
                     && shape_cdf[end as usize - 1] > 0.0
             })
             .collect();
-        let chords = scene
-            .shapes()
-            .iter()
-            .map(|s| s.medium.map_or(0.0, |_| chord_bound(&s.vertices)))
-            .collect();
+        let media = Media::new(scene.shapes().iter().enumerate().map(|(k, s)| {
+            let coefficients = s.medium.map(|m| Coefficients { ks: m.ks, ke: m.ke });
+            (coefficients, &s.vertices[..], scene.parent_medium(k as u32))
+        }));
         Plane {
-            chords,
+            media,
             scene,
             corner_segments,
             moving_corners,
@@ -380,22 +378,8 @@ impl Geometry for Plane {
         s.closed && s.surface != Surface::Transparent
     }
     #[inline]
-    fn coefficients(&self, m: MediumId) -> Option<Coefficients> {
-        self.scene
-            .medium(m)
-            .map(|m| Coefficients { ks: m.ks, ke: m.ke })
-    }
-    #[inline]
-    fn medium_chord(&self, m: MediumId) -> f64 {
-        m.map_or(f64::INFINITY, |k| self.chords[k as usize])
-    }
-    #[inline]
-    fn crossed(&self, m: MediumId, k: u32) -> MediumId {
-        if m == Some(k) {
-            self.scene.parent_medium(k)
-        } else {
-            Some(k)
-        }
+    fn media(&self) -> &Media {
+        &self.media
     }
     #[inline]
     fn cosine_lobe(&self, n: DVec2, c: f64) -> FlatLobe {

@@ -13,7 +13,7 @@ use super::poles::PoleTable;
 use super::scene::{Scene, Sensor as SceneSensor};
 use super::sensor_view::SensorView;
 use crate::path::deform::SlotSet;
-use crate::path::thin_media::chord_bound;
+use crate::path::media::Media;
 use crate::path::{
     Coefficients, Geometry, Hit, MediumId, NO_PRIM, PixelSample, Prim, Sensor, Surface,
 };
@@ -51,9 +51,8 @@ pub struct Space {
     pub(super) sampler: EdgeSampler,
     /// Per mesh, the parameters that move it.
     pub(super) shape_params: Vec<SlotSet>,
-    /// Per mesh holding a medium, a bound on its chords ([`chord_bound`]);
-    /// 0 for the others (the walk asks only of media).
-    chords: Vec<f64>,
+    /// The media, for the walk.
+    media: Media,
     /// The warp's fibre families.
     pub(super) poles: PoleTable,
 }
@@ -104,11 +103,10 @@ impl Space {
             shape_params[scene.parameter_shape(j) as usize].insert(j);
         }
         Space {
-            chords: scene
-                .shapes()
-                .iter()
-                .map(|s| s.medium.map_or(0.0, |_| chord_bound(&s.vertices)))
-                .collect(),
+            media: Media::new(scene.shapes().iter().enumerate().map(|(k, s)| {
+                let coefficients = s.medium.map(|m| Coefficients { ks: m.ks, ke: m.ke });
+                (coefficients, &s.vertices[..], scene.parent_medium(k as u32))
+            })),
             caster: TriangleBvh::new(tris.clone()),
             opaque: TriangleBvh::new(opaque_tris),
             opaque_index,
@@ -291,22 +289,8 @@ impl Geometry for Space {
         self.scene.is_solid(self.owner[p as usize])
     }
     #[inline]
-    fn coefficients(&self, m: MediumId) -> Option<Coefficients> {
-        self.scene
-            .medium(m)
-            .map(|m| Coefficients { ks: m.ks, ke: m.ke })
-    }
-    #[inline]
-    fn medium_chord(&self, m: MediumId) -> f64 {
-        m.map_or(f64::INFINITY, |k| self.chords[k as usize])
-    }
-    #[inline]
-    fn crossed(&self, m: MediumId, k: u32) -> MediumId {
-        if m == Some(k) {
-            self.scene.parent_medium(k)
-        } else {
-            Some(k)
-        }
+    fn media(&self) -> &Media {
+        &self.media
     }
     #[inline]
     fn cosine_lobe(&self, n: DVec3, c: f64) -> SpaceLobe {

@@ -28,6 +28,7 @@ pub mod derivative_walk;
 pub mod estimator;
 pub mod expectation;
 pub mod intensity;
+pub mod media;
 pub mod nested;
 pub mod rendering;
 pub mod thin_media;
@@ -293,17 +294,30 @@ pub trait Geometry: Sync {
     fn solid(&self, _p: Prim) -> bool {
         false
     }
+    /// The scene's media (none by default).
+    fn media(&self) -> &media::Media {
+        &media::NO_MEDIA
+    }
     /// The coefficients of medium `m` (`None`: vacuum).
-    fn coefficients(&self, m: MediumId) -> Option<Coefficients>;
+    #[inline]
+    fn coefficients(&self, m: MediumId) -> Option<Coefficients> {
+        self.media().coefficients(m)
+    }
     /// An upper bound on the length of a straight path inside medium `m`
     /// ([`thin_media::chord_bound`] of its boundary's vertices): in an
     /// optically thin medium the walk draws collisions as if it were
     /// [`thin_media::THIN_DEPTH`] thick over this length
     /// ([`thin_media::collision_rate`]).
-    fn medium_chord(&self, m: MediumId) -> f64;
+    #[inline]
+    fn medium_chord(&self, m: MediumId) -> f64 {
+        self.media().chord(m)
+    }
     /// The medium entered or left when a ray in `m` crosses the transparent
     /// boundary of shape `k`.
-    fn crossed(&self, m: MediumId, k: u32) -> MediumId;
+    #[inline]
+    fn crossed(&self, m: MediumId, k: u32) -> MediumId {
+        self.media().crossed(m, k)
+    }
     /// The cosine lobe `c (η·n)⁺` about the unit normal `n`.
     fn cosine_lobe(&self, n: Self::V, c: f64) -> Self::Lobe;
     /// The phase function of medium `m` about the incoming direction `w`.
