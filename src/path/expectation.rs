@@ -15,6 +15,7 @@
 //!
 //! Book: chapter "Flatland: one deformation, three estimators", sections
 //! "Expectation" and "The warp field".
+use super::deform::{Deform, SlotSet};
 use super::derivative_walk::DerivativeWalk;
 use super::walk::{Hooks, Vertex};
 use super::{Boundaries, Geometry, Hit, Lobe, MovingVertex, Vector};
@@ -108,16 +109,8 @@ impl<G: Boundaries> Hooks<G> for Expectation<'_, G> {
     }
     // ANCHOR_END: collision
     #[inline]
-    fn pass(&mut self, ke: f64) {
-        self.walk.d.pass(self.walk.slots.all(), ke);
-    }
-    #[inline]
-    fn arrive(&mut self, w: G::V, t: f64) {
-        self.walk.d.arrive(self.walk.slots.all(), w, t);
-    }
-    #[inline]
-    fn emission(&mut self, contribution: f64) {
-        self.walk.d.collect(contribution);
+    fn carried(&mut self) -> Option<(&mut Deform<G::V>, SlotSet)> {
+        Some((&mut self.walk.d, self.walk.slots.all()))
     }
     #[inline]
     fn visit(&mut self, _x: G::V) {

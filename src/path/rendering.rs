@@ -342,20 +342,8 @@ impl<G: Boundaries> Hooks<G> for Rendering<'_, G> {
         }
     }
     #[inline]
-    fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
-        self.walk.d.carry(xi);
-    }
-    #[inline]
-    fn pass(&mut self, ke: f64) {
-        self.walk.d.pass(self.walk.slots.all(), ke);
-    }
-    #[inline]
-    fn arrive(&mut self, w: G::V, t: f64) {
-        self.walk.d.arrive(self.walk.slots.all(), w, t);
-    }
-    #[inline]
-    fn emission(&mut self, contribution: f64) {
-        self.walk.d.collect(contribution);
+    fn carried(&mut self) -> Option<(&mut Deform<G::V>, SlotSet)> {
+        Some((&mut self.walk.d, self.walk.slots.all()))
     }
     #[inline]
     fn connect(&mut self, g: &G, rng: &mut PathRng, v: &Vertex<G>) -> f64 {

@@ -16,11 +16,11 @@
 //! The sensor-position slots (`∂I/∂x`, …) follow rendering's rules.
 //! Book: chapter "Flatland: one deformation, three estimators", section
 //! "Transport"; in 3D, chapter "Three dimensions", section "Transport in 3D".
-use super::deform::Deform;
+use super::deform::{Deform, SlotSet};
 use super::derivative_walk::{DerivativeWalk, SceneMotion};
 use super::nested::radiance;
 use super::rendering::Rendering;
-use super::walk::{Drawn, Hooks, Leg, Ray, Vertex, walk};
+use super::walk::{Drawn, Hooks, Landing, Leg, Ray, Vertex, walk};
 use super::{Boundaries, Coefficients, Geometry, Hit, MediumId, NO_PRIM, Vector};
 use crate::rng::PathRng;
 
@@ -58,17 +58,11 @@ impl<G: Boundaries> Transport<'_, G> {
 
     // ANCHOR: surface_gradient
     /// The source `−v·∇L(y⁻, w)` where the leg hits the opaque moving
-    /// boundary of shape `k` at `y`, for every shape-parameter slot: the
-    /// gradient by a nested walk in the frozen scene started just before `y`.
-    fn surface_gradient(
-        &mut self,
-        g: &G,
-        rng: &mut PathRng,
-        leg: &Leg<G>,
-        y: G::V,
-        k: u32,
-        drawn: Option<Drawn<G::V>>,
-    ) {
+    /// boundary of shape `k` at `y` (`at`), for every shape-parameter slot:
+    /// the gradient by a nested walk in the frozen scene started just
+    /// before `y`.
+    fn surface_gradient(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, at: Landing<G::V>) {
+        let Landing { y, k, drawn } = at;
         let Leg { x, w, medium, beta } = *leg;
         let walk = &mut self.walk;
         let Some(weight) = walk.scratch.work.admit(rng) else {
@@ -212,33 +206,13 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
         self.walk.scratch.work.main += 1;
     }
     #[inline]
-    fn collision(&mut self, _w: G::V, xi: f64, _t_b: f64, _ke: f64) {
-        self.walk.d.carry(xi);
+    fn carried(&mut self) -> Option<(&mut Deform<G::V>, SlotSet)> {
+        Some((&mut self.walk.d, self.walk.slots.frozen_scene()))
     }
     #[inline]
-    fn pass(&mut self, ke: f64) {
-        self.walk.d.pass(self.walk.slots.frozen_scene(), ke);
-    }
-    #[inline]
-    fn arrive(&mut self, w: G::V, t: f64) {
-        self.walk.d.arrive(self.walk.slots.frozen_scene(), w, t);
-    }
-    #[inline]
-    fn emission(&mut self, contribution: f64) {
-        self.walk.d.collect(contribution);
-    }
-    #[inline]
-    fn opaque(
-        &mut self,
-        g: &G,
-        rng: &mut PathRng,
-        leg: &Leg<G>,
-        y: G::V,
-        k: u32,
-        drawn: Option<Drawn<G::V>>,
-    ) {
+    fn opaque(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, at: Landing<G::V>) {
         if self.euler_moving() {
-            self.surface_gradient(g, rng, leg, y, k, drawn);
+            self.surface_gradient(g, rng, leg, at);
         }
     }
     // ANCHOR: interface
@@ -302,7 +276,16 @@ impl<G: Boundaries> Hooks<G> for Transport<'_, G> {
         if self.walk.slots.twins > 0 {
             self.twin_gradient(g, rng, leg, v, k);
         } else {
-            self.surface_gradient(g, rng, leg, v.x, k, None);
+            self.surface_gradient(
+                g,
+                rng,
+                leg,
+                Landing {
+                    y: v.x,
+                    k,
+                    drawn: None,
+                },
+            );
         }
         // The material derivative of the reflected radiance: the point moves
         // with the surface (the corner terms see it move).

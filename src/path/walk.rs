@@ -7,6 +7,7 @@
 //! with the unit hooks `()`; each derivative method observes its events
 //! through [`Hooks`] and adds its own terms. Book: chapter "Flatland",
 //! sections "Backward path tracing" and "Next-event estimation".
+use super::deform::{Deform, SlotSet};
 use super::thin_media::collision_rate;
 use super::{Coefficients, Geometry, Hit, Lobe, MediumId, NO_PRIM, Prim, Surface, Vector, mis};
 use crate::rng::{PathRng, free_path};
@@ -63,6 +64,18 @@ pub struct Drawn<V> {
     pub pdf: f64,
     /// The vertex.
     pub from: V,
+}
+
+/// Where a leg ends on an opaque surface: the point `y` on shape `k`, and
+/// how the leg's direction was drawn (`None`: it was given).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Landing<V> {
+    /// The point.
+    pub y: V,
+    /// Its shape.
+    pub k: u32,
+    /// How the direction was drawn.
+    pub drawn: Option<Drawn<V>>,
 }
 
 /// A straight leg of a path: from `x` along the unit `w` through `medium`,
@@ -148,34 +161,50 @@ pub trait Hooks<G: Geometry> {
     /// free path is drawn.
     #[inline]
     fn free_path_domain(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, t_b: f64) {}
-    /// A collision at `xi < t_b` along `w` in a medium of extinction `ke`.
+    /// A derivative walk's deformation and the slots its media's
+    /// extinction acts on (`pass`, `arrive`): what the default hooks below
+    /// carry along the path, the same in every derivative method. `None`
+    /// (the intensity estimator's) makes them no-ops.
     #[inline]
-    fn collision(&mut self, w: G::V, xi: f64, t_b: f64, ke: f64) {}
+    fn carried(&mut self) -> Option<(&mut Deform<G::V>, SlotSet)> {
+        None
+    }
+    /// A collision at `xi < t_b` along `w` in a medium of extinction `ke`:
+    /// by default the vertex is carried along the free path, which keeps
+    /// its length.
+    #[inline]
+    fn collision(&mut self, w: G::V, xi: f64, t_b: f64, ke: f64) {
+        if let Some((d, _)) = self.carried() {
+            d.carry(xi);
+        }
+    }
     /// The segment reached its boundary through a medium of extinction `ke`.
     #[inline]
-    fn pass(&mut self, ke: f64) {}
+    fn pass(&mut self, ke: f64) {
+        if let Some((d, slots)) = self.carried() {
+            d.pass(slots, ke);
+        }
+    }
     /// The vertex moves onto the boundary at distance `t` along `w`.
     #[inline]
-    fn arrive(&mut self, w: G::V, t: f64) {}
+    fn arrive(&mut self, w: G::V, t: f64) {
+        if let Some((d, slots)) = self.carried() {
+            d.arrive(slots, w, t);
+        }
+    }
     /// A path vertex (figures draw paths with it).
     #[inline]
     fn visit(&mut self, x: G::V) {}
     /// An emission `contribution` is collected.
     #[inline]
-    fn emission(&mut self, contribution: f64) {}
-    /// The leg ends on the opaque surface of shape `k` at `y`; `drawn`:
-    /// how its direction was drawn (`None`: it was given).
-    #[inline]
-    fn opaque(
-        &mut self,
-        g: &G,
-        rng: &mut PathRng,
-        leg: &Leg<G>,
-        y: G::V,
-        k: u32,
-        drawn: Option<Drawn<G::V>>,
-    ) {
+    fn emission(&mut self, contribution: f64) {
+        if let Some((d, _)) = self.carried() {
+            d.collect(contribution);
+        }
     }
+    /// The leg ends on an opaque surface, at `at`.
+    #[inline]
+    fn opaque(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, at: Landing<G::V>) {}
     /// The leg crosses the transparent boundary at `y` into `after`.
     #[inline]
     fn interface(&mut self, g: &G, rng: &mut PathRng, leg: &Leg<G>, y: G::V, after: MediumId) {}
@@ -416,14 +445,14 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
         let k = g.shape(h.prim);
         match g.surface(h.prim) {
             Surface::Emitter { radiance } => {
-                hooks.opaque(g, rng, &leg, x, k, drawn);
+                hooks.opaque(g, rng, &leg, Landing { y: x, k, drawn });
                 let weight = drawn.map_or(1.0, |d| mis(d.pdf, g.light_pdf(d.from, x, h.prim)));
                 let contribution = beta * radiance * weight;
                 hooks.emission(contribution);
                 return total + contribution;
             }
             Surface::Absorber => {
-                hooks.opaque(g, rng, &leg, x, k, drawn);
+                hooks.opaque(g, rng, &leg, Landing { y: x, k, drawn });
                 return total;
             }
             Surface::Transparent => {
@@ -432,7 +461,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                 medium = next;
             }
             Surface::Reflector { .. } if behind_solid(g, h.prim, x, w) => {
-                hooks.opaque(g, rng, &leg, x, k, drawn);
+                hooks.opaque(g, rng, &leg, Landing { y: x, k, drawn });
                 return total;
             }
             Surface::Reflector { albedo } => {
