@@ -10,7 +10,9 @@ use super::lobe::FlatLobe;
 use super::space::{Knot, Plane};
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
-use crate::path::{Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, Side};
+use crate::path::{
+    Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, Side, nearest_sides,
+};
 use glam::DVec2;
 use std::f64::consts::TAU;
 
@@ -156,25 +158,14 @@ impl Boundaries for Plane {
     fn sides(&self, x: DVec2, b: &BoundaryPoint<DVec2>) -> (Side, Side) {
         let w = (b.q - x).normalize();
         let segments = self.scene.segments();
-        let (mut ccw, mut cw) = ((f64::INFINITY, Side::Past), (f64::INFINITY, Side::Past));
-        for s in self.corner_segments[b.index as usize] {
-            if s == NO_SEGMENT {
-                continue;
-            }
-            let seg = segments[s as usize];
-            let other = far_end(&seg, b.q);
-            let d = other - b.q;
-            let c = cross(w, d);
-            if c == 0.0 {
-                continue; // along the sight line: a grazing ray sees none of it
-            }
-            let order = d.dot(w) / c.abs();
-            let side = if c > 0.0 { &mut ccw } else { &mut cw };
-            if order < side.0 {
-                *side = (order, Side::Surface(s));
-            }
-        }
-        (ccw.1, cw.1)
+        let at_corner = self.corner_segments[b.index as usize]
+            .into_iter()
+            .filter(|&s| s != NO_SEGMENT)
+            .map(|s| {
+                let d = far_end(&segments[s as usize], b.q) - b.q;
+                (s, d, cross(w, d))
+            });
+        nearest_sides(w, at_corner)
     }
 
     // ANCHOR_END: sides

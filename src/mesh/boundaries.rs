@@ -49,7 +49,7 @@ use super::warp::SpaceWarp;
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
 use crate::path::{
-    Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, NO_PRIM, Prim, Side,
+    Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, NO_PRIM, Prim, Side, nearest_sides,
 };
 use crate::rng::PathRng;
 use glam::DVec3;
@@ -456,23 +456,15 @@ impl Boundaries for Space {
         let w = (b.q - x).normalize();
         let n = self.boundary_normal(x, b);
         let e = b.index as usize;
-        let (mut ahead, mut behind) = ((f64::INFINITY, Side::Past), (f64::INFINITY, Side::Past));
-        for p in self.edge_tables().edges[e].faces {
-            if p == NO_PRIM {
-                continue;
-            }
-            let d = self.face_inward(e, p);
-            let c = d.dot(n);
-            if c == 0.0 {
-                continue; // seen edge-on: a grazing ray sees none of it
-            }
-            let order = d.dot(w) / c.abs();
-            let side = if c > 0.0 { &mut ahead } else { &mut behind };
-            if order < side.0 {
-                *side = (order, Side::Surface(p));
-            }
-        }
-        (ahead.1, behind.1)
+        let at_edge = self.edge_tables().edges[e]
+            .faces
+            .into_iter()
+            .filter(|&p| p != NO_PRIM)
+            .map(|p| {
+                let d = self.face_inward(e, p);
+                (p, d, d.dot(n))
+            });
+        nearest_sides(w, at_edge)
     }
     // ANCHOR_END: sides
     #[inline]

@@ -392,6 +392,31 @@ pub enum Side {
     Past,
 }
 
+/// What rays just to either side of the sight line `w` meet at a boundary
+/// point, of the surfaces there given as `(p, d, c)`: primitive `p`, its
+/// direction `d` from the point, `c` its component across the line
+/// (positive on the first side, negative on the second). On each side the
+/// ray meets first the surface of least `(d·w)/|c|`; one along the line
+/// (`c = 0`) a grazing ray sees nothing of. Flatland's corners and 3D's
+/// edges both (`Boundaries::sides`).
+pub fn nearest_sides<V: Vector>(
+    w: V,
+    surfaces: impl IntoIterator<Item = (Prim, V, f64)>,
+) -> (Side, Side) {
+    let (mut first, mut second) = ((f64::INFINITY, Side::Past), (f64::INFINITY, Side::Past));
+    for (p, d, c) in surfaces {
+        if c == 0.0 {
+            continue;
+        }
+        let order = d.dot(w) / c.abs();
+        let side = if c > 0.0 { &mut first } else { &mut second };
+        if order < side.0 {
+            *side = (order, Side::Surface(p));
+        }
+    }
+    (first.1, second.1)
+}
+
 /// Whom the boundary term at a vertex serves, as the draw of its boundary
 /// point needs to know: a slot whose vertex or frame moves sees every
 /// discontinuity move; a shape parameter otherwise sees only its own
