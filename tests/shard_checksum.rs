@@ -1,54 +1,10 @@
 //! A shard's state carries a checksum of its data (`State::data_checksum`):
 //! a state changed after its shard wrote it is refused by name, an
 //! untouched one, however laid out, merges to the single run bit for bit.
+mod common;
+use common::cli::{ok, refused, repo, scratch, without_seconds};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn geosens(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_geosens"))
-        .args(args)
-        .output()
-        .expect("the geosens binary runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = geosens(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn refused(args: &[&str]) -> String {
-    let out = geosens(args);
-    assert_eq!(out.status.code(), Some(1), "{args:?} was not refused");
-    String::from_utf8(out.stderr).unwrap()
-}
-
-fn repo(path: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(path)
-        .to_str()
-        .unwrap()
-        .to_owned()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("geosens-checksum-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The JSON line without its wall time.
-fn without_seconds(line: &str) -> Value {
-    let mut v: Value = serde_json::from_str(line).unwrap();
-    v.as_object_mut().unwrap().remove("seconds");
-    v
-}
+use std::path::Path;
 
 /// Runs `base` as `n` shards through the CLI (last shard first) and returns
 /// the state files.

@@ -2,58 +2,13 @@
 //! merge`) print exactly what the single run prints, for every estimation
 //! command, whatever the number of shards and threads; states that are not
 //! one whole run are refused with a message naming the fault.
+mod common;
+use common::cli::{geosens, ok, refused, repo, scratch, without_seconds};
 use geosens::job::{Job, SceneSource, Target};
 use geosens::shard::{Merged, Shard, State, merge};
 use geosens::{Method, RunConfig};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn geosens(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_geosens"))
-        .args(args)
-        .output()
-        .expect("the geosens binary runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = geosens(args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
-fn refused(args: &[&str]) -> String {
-    let out = geosens(args);
-    assert_eq!(out.status.code(), Some(1), "{args:?} was not refused");
-    String::from_utf8(out.stderr).unwrap()
-}
-
-fn repo(path: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(path)
-        .to_str()
-        .unwrap()
-        .to_owned()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("geosens-shards-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// The JSON line without its wall time, the one field a merge cannot
-/// repeat.
-fn without_seconds(line: &str) -> Value {
-    let mut v: Value = serde_json::from_str(line).unwrap();
-    v.as_object_mut().unwrap().remove("seconds");
-    v
-}
+use std::path::Path;
 
 /// A table without its timing line's seconds.
 fn without_time(table: &str) -> String {

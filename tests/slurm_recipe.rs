@@ -3,33 +3,13 @@
 //! `#SBATCH` lines are comments), with `sbatch` and `sinfo` stand-ins on
 //! `PATH` that record what would be submitted. `.ci/cluster` runs the same
 //! recipe on a real one-node Slurm.
+mod common;
+use common::cli::{repo, scratch, without_seconds};
 use geosens::shard::{Shard, array_spec};
-use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 const GEOSENS: &str = env!("CARGO_BIN_EXE_geosens");
-
-fn repo(path: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(path)
-        .to_str()
-        .unwrap()
-        .to_owned()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("geosens-slurm-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn without_seconds(line: &str) -> Value {
-    let mut v: Value = serde_json::from_str(line).unwrap();
-    v.as_object_mut().unwrap().remove("seconds");
-    v
-}
 
 fn text(out: &[u8]) -> String {
     String::from_utf8_lossy(out).into_owned()

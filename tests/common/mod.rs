@@ -3,6 +3,8 @@
 use geosens::rod::{Direction, Method, Probe, Rod, exact};
 use geosens::{Quantity, RunConfig, RunResult, run};
 
+pub mod cli;
+
 /// The paper's thin rod (κs = 0.07, κe = 0.1, π̃ = 2).
 pub fn thin() -> Rod {
     Rod::new(0.07, 0.1, 2.0).unwrap()
