@@ -1,6 +1,6 @@
 //! Ray casting on triangle meshes: `TriangleBvh` (obvhs's tree, `f64`
 //! watertight triangle test) against obvhs's own `f32` traversal and
-//! triangle test, and against `LinearTriangles` on small meshes.
+//! triangle test, and against `TriangleBvh::linear` on small meshes.
 //!
 //! ```text
 //! cargo bench --bench mesh_raycast                 # everything, about 1.5 min
@@ -22,10 +22,10 @@
 //!   `build_bvh2_from_tris` (both PLOC, `medium_build`).
 //! - `mesh_raycast/crossover/{4..512}`: n triangles evenly picked from a
 //!   torus of 512 (`R = 0.7`, `r = 0.3`), the same rays, a tree forced at
-//!   every size (`bvh`) against `LinearTriangles`:
+//!   every size (`bvh`) against `TriangleBvh::linear`:
 //!   below which n the scan wins (`geosens::mesh::bvh::LINEAR_BELOW`).
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use geosens::mesh::bvh::{LinearTriangles, TriangleBvh};
+use geosens::mesh::bvh::TriangleBvh;
 use glam::{DVec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::builder::build_bvh2_from_tris;
@@ -160,7 +160,7 @@ fn trace(bvh: &TriangleBvh, rays: &[(DVec3, DVec3)]) -> f64 {
 }
 
 /// The same with the linear scan.
-fn trace_linear(scan: &LinearTriangles, rays: &[(DVec3, DVec3)]) -> f64 {
+fn trace_linear(scan: &TriangleBvh, rays: &[(DVec3, DVec3)]) -> f64 {
     rays.iter()
         .filter_map(|&(o, d)| scan.closest_hit(o, d, f64::INFINITY, NONE))
         .map(|h| h.0)
@@ -250,7 +250,7 @@ fn crossover(c: &mut Criterion) {
     for n in [4, 8, 12, 16, 24, 32, 64, 512] {
         let tris: Vec<Tri> = full.iter().step_by(512 / n).take(n).copied().collect();
         let bvh = TriangleBvh::with_linear_below(tris.clone(), 0);
-        let scan = LinearTriangles::new(tris);
+        let scan = TriangleBvh::linear(tris);
         assert_eq!(trace(&bvh, &rays), trace_linear(&scan, &rays));
         let mut g = c.benchmark_group(format!("mesh_raycast/crossover/{n}"));
         g.throughput(Throughput::Elements(RAYS as u64))

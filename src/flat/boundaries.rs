@@ -11,7 +11,7 @@ use super::space::{Knot, Plane};
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
 use crate::path::{
-    Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, Side, nearest_sides,
+    Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, Side, Warping, nearest_sides,
 };
 use glam::DVec2;
 use std::f64::consts::TAU;
@@ -178,31 +178,6 @@ impl Boundaries for Plane {
         perp((b.q - x).normalize())
     }
 
-    type Warp = FlatWarp;
-
-    fn warp(
-        &self,
-        v: &Vertex<Self>,
-        w: DVec2,
-        ahead: Option<Option<Hit>>,
-        _frame: SlotSet,
-    ) -> FlatWarp {
-        let horizons = v.lobe.horizons(w);
-        let (ccw, cw) = if v.at_sensor {
-            self.sensor_knots(w, horizons)
-        } else {
-            self.nearest_knots(v.x, v.skip, w, ahead, horizons)
-        };
-        FlatWarp { ccw, cw, horizons }
-    }
-
-    #[inline]
-    fn warp_shapes(&self, warp: &FlatWarp, mut f: impl FnMut(u32)) {
-        for k in [warp.ccw, warp.cw].into_iter().flatten() {
-            f(k.2);
-        }
-    }
-
     /// A point on segment `p` a hair from the corner: 10⁻⁹ of the scene's
     /// size, or further where the corner is sharp and far from the origin.
     /// The point must stay on its side of the corner's other segment,
@@ -230,6 +205,35 @@ impl Boundaries for Plane {
             .max(rounding / sin.max(f64::MIN_POSITIVE))
             .min(0.5 * seg.length());
         b.q + along * step
+    }
+}
+
+/// The warp of flatland: linear in angle between the nearest visible
+/// corners (or the lobe's horizons).
+impl Warping for Plane {
+    type Warp = FlatWarp;
+
+    fn warp(
+        &self,
+        v: &Vertex<Self>,
+        w: DVec2,
+        ahead: Option<Option<Hit>>,
+        _frame: SlotSet,
+    ) -> FlatWarp {
+        let horizons = v.lobe.horizons(w);
+        let (ccw, cw) = if v.at_sensor {
+            self.sensor_knots(w, horizons)
+        } else {
+            self.nearest_knots(v.x, v.skip, w, ahead, horizons)
+        };
+        FlatWarp { ccw, cw, horizons }
+    }
+
+    #[inline]
+    fn warp_shapes(&self, warp: &FlatWarp, mut f: impl FnMut(u32)) {
+        for k in [warp.ccw, warp.cw].into_iter().flatten() {
+            f(k.2);
+        }
     }
 
     // ANCHOR: warp_velocity

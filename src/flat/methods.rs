@@ -30,7 +30,7 @@ use crate::path::deform::SlotSet;
 use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::thin_media::chord_bound;
 use crate::path::walk::{Frame, Vertex};
-use crate::path::{Boundaries, MovingVertex, NO_PRIM, Surface};
+use crate::path::{MovingVertex, NO_PRIM, Surface, Warping};
 use glam::DVec2;
 use std::sync::Arc;
 

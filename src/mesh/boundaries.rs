@@ -45,12 +45,8 @@
 use super::edges::{EdgeTree, is_discontinuity};
 use super::lobe::SpaceLobe;
 use super::space::Space;
-use super::warp::SpaceWarp;
-use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
-use crate::path::{
-    Boundaries, BoundaryPoint, BoundaryView, Hit, MovingVertex, NO_PRIM, Prim, Side, nearest_sides,
-};
+use crate::path::{Boundaries, BoundaryPoint, BoundaryView, NO_PRIM, Prim, Side, nearest_sides};
 use crate::rng::PathRng;
 use glam::DVec3;
 use rand::RngExt;
@@ -486,34 +482,6 @@ impl Boundaries for Space {
     fn off_boundary(&self, b: &BoundaryPoint<DVec3>, p: Prim) -> DVec3 {
         let d = self.face_inward(b.index as usize, p);
         b.q + d * crate::path::Geometry::nudge(self, b.q)
-    }
-
-    /// The fibre warp of [`super::warp`].
-    type Warp = SpaceWarp;
-
-    fn warp(
-        &self,
-        v: &Vertex<Self>,
-        w: DVec3,
-        _ahead: Option<Option<Hit>>,
-        frame: SlotSet,
-    ) -> SpaceWarp {
-        self.fibre_warp(v, w, frame)
-    }
-
-    fn warp_shapes(&self, warp: &SpaceWarp, f: impl FnMut(u32)) {
-        self.fibre_shapes(warp, f)
-    }
-
-    fn warp_velocity(
-        &self,
-        warp: &SpaceWarp,
-        slot: usize,
-        vertex: MovingVertex<DVec3>,
-        w: DVec3,
-        velocity: impl Fn(DVec3, u32) -> DVec3,
-    ) -> (DVec3, f64) {
-        self.fibre_velocity(warp, slot, vertex, w, velocity)
     }
 }
 

@@ -1,7 +1,7 @@
 //! Ray casting against triangles: the `f64` ray–triangle test
-//! [`intersect`], a bounding volume hierarchy [`TriangleBvh`] and the
-//! brute-force [`LinearTriangles`], which answer every query alike, bit for
-//! bit. The tree, its unit frame and its traversal are shared with
+//! [`intersect`], a bounding volume hierarchy [`TriangleBvh`] and its
+//! brute-force form [`TriangleBvh::linear`], which answer every query alike,
+//! bit for bit. The tree, its unit frame and its traversal are shared with
 //! flatland's [`SegmentBvh`](crate::flat::bvh::SegmentBvh) in
 //! [`bvh_frame`](crate::bvh_frame); this module adds the triangle.
 //!
@@ -75,7 +75,7 @@ use glam::DVec3;
 #[cfg(test)]
 use crate::bvh_frame::NONE;
 pub use crate::bvh_frame::PAD;
-use crate::bvh_frame::{Primitive, Tree, scan_any, scan_closest};
+use crate::bvh_frame::{Primitive, Tree};
 
 /// Smallest ray distance counted as a hit, relative to the longest edge of
 /// the triangle hit (and to the size of the ray direction; the path
@@ -267,59 +267,8 @@ impl Primitive for Prim {
     }
 }
 
-/// Ray casting by testing every triangle: the reference [`TriangleBvh`] is
-/// checked against, and the faster caster for a handful of triangles.
-#[derive(Debug, Clone)]
-pub struct LinearTriangles {
-    /// The finite triangles, in list order.
-    prims: Vec<Prim>,
-    /// Length of the list given.
-    count: usize,
-}
-
-impl LinearTriangles {
-    /// A caster over `triangles` (index = position in the list); non-finite
-    /// triangles are never hit.
-    pub fn new(triangles: Vec<[DVec3; 3]>) -> LinearTriangles {
-        let count = triangles.len();
-        LinearTriangles {
-            prims: finite_prims(triangles),
-            count,
-        }
-    }
-
-    /// The closest triangle other than `skip` (`u32::MAX`: none) crossed by
-    /// `origin + t dir` with `t < t_max`, as `(t, index)`; ties go to the
-    /// lowest index.
-    pub fn closest_hit(
-        &self,
-        origin: DVec3,
-        dir: DVec3,
-        t_max: f64,
-        skip: u32,
-    ) -> Option<(f64, u32)> {
-        scan_closest(&self.prims, &Shear::new(origin, dir), t_max, skip)
-    }
-
-    /// Whether any triangle other than `skip` (`u32::MAX`: none) is crossed
-    /// by `origin + t dir` with `t < t_max`.
-    pub fn any_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, skip: u32) -> bool {
-        scan_any(&self.prims, &Shear::new(origin, dir), t_max, skip)
-    }
-
-    /// Length of the list given (non-finite triangles included).
-    pub fn len(&self) -> usize {
-        self.count
-    }
-
-    /// Whether the list given was empty.
-    pub fn is_empty(&self) -> bool {
-        self.count == 0
-    }
-}
-
 /// A BVH ray caster over a fixed list of triangles; see the [module
-/// docs](self). Answers exactly as [`LinearTriangles`] over the same list.
+/// docs](self). Answers exactly as [`TriangleBvh::linear`] over the same list.
 #[derive(Clone)]
 pub struct TriangleBvh {
     /// The finite triangles (no tree below [`LINEAR_BELOW`]).
@@ -342,10 +291,17 @@ impl fmt::Debug for TriangleBvh {
 impl TriangleBvh {
     /// A caster over `triangles` (index = position in the list). Any list
     /// is accepted: an empty one is never hit, and non-finite triangles,
-    /// which [`LinearTriangles`] never reports either, are left out. Below
+    /// which a linear scan never reports either, are left out. Below
     /// [`LINEAR_BELOW`] finite triangles no tree is built.
     pub fn new(triangles: Vec<[DVec3; 3]>) -> TriangleBvh {
         TriangleBvh::with_linear_below(triangles, LINEAR_BELOW)
+    }
+
+    /// Ray casting by testing every triangle in list order, no tree: the
+    /// reference the tree is checked against (the tree's own traversal is
+    /// not used, only the scan its leaves make).
+    pub fn linear(triangles: Vec<[DVec3; 3]>) -> TriangleBvh {
+        TriangleBvh::with_linear_below(triangles, usize::MAX)
     }
 
     /// [`TriangleBvh::new`] with a tree from `linear_below` finite
@@ -371,7 +327,7 @@ impl TriangleBvh {
 
     /// The closest triangle other than `skip` (`u32::MAX`: none) crossed by
     /// `origin + t dir` with `t < t_max`, as `(t, index)`; exactly
-    /// [`LinearTriangles::closest_hit`]'s answer (ties to the lowest index).
+    /// the linear scan's answer (ties to the lowest index).
     pub fn closest_hit(
         &self,
         origin: DVec3,
@@ -384,7 +340,7 @@ impl TriangleBvh {
 
     /// Whether any triangle other than `skip` (`u32::MAX`: none) is crossed
     /// by `origin + t dir` with `t < t_max`; exactly
-    /// [`LinearTriangles::any_hit`]'s answer.
+    /// the linear scan's answer.
     pub fn any_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, skip: u32) -> bool {
         self.tree.any_hit(origin, dir, t_max, skip)
     }

@@ -38,6 +38,7 @@ use super::space::Space;
 use crate::path::MovingVertex;
 use crate::path::deform::SlotSet;
 use crate::path::walk::Vertex;
+use crate::path::{Hit, Warping};
 use glam::DVec3;
 
 /// A fibre of the warp at the vertex `x`: the half great circle of
@@ -125,83 +126,6 @@ fn meets_half_plane(d: DVec3, r: f64, u: DVec3, m: DVec3) -> bool {
 }
 
 impl Space {
-    /// The warp at `v` around `w`: a field per pole rule. A family none of
-    /// whose slots is in `frame` (vertex and frame still) is zero unless its
-    /// fibre meets a mesh its slots move: it is left zero there, unsearched.
-    pub(super) fn fibre_warp(&self, v: &Vertex<Self>, w: DVec3, frame: SlotSet) -> SpaceWarp {
-        let still = FibreKnot {
-            cos: 1.0,
-            edge: None,
-        };
-        let blank = FibreField {
-            m: DVec3::ZERO,
-            cos: 1.0,
-            sin: 0.0,
-            e_w: DVec3::ZERO,
-            lo: still,
-            hi: still,
-        };
-        let mut warp = SpaceWarp {
-            fields: [blank; MAX_FIELDS],
-            count: self.poles.rules.len(),
-        };
-        if let SpaceLobe::Pixel { frame, rect, pixel } = v.lobe {
-            // At a camera, one family for every slot: the image's rows
-            // (pole on the camera's right axis) or its columns (pole up),
-            // whichever the pixel's moving edges cross more steeply (a
-            // crossing slides along its fibre at v_n / sin of the angle
-            // between edge and fibre; chosen once per pixel when its edges
-            // are cut, `PixelEdges::along_rows`). The stratum's sides
-            // across the fibres are the ends; the other two are fibres. See
-            // `super::camera`.
-            let [f, r, u] = frame;
-            let (pole, ends) = if self.pixel_edges().along_rows(pixel) {
-                (r, [u.cross(f + r * rect[0]), u.cross(f + r * rect[1])])
-            } else {
-                (u, [r.cross(f + u * rect[2]), r.cross(f + u * rect[3])])
-            };
-            warp.count = 1;
-            let quiet = frame
-                .is_empty()
-                .then(|| &self.poles.field_bounds[self.poles.rules.len()][..]);
-            warp.fields[0] = self.fibre_field(v, w, pole, ends, quiet);
-            return warp;
-        }
-        // A cosine lobe ends at its horizon.
-        let ends = match v.lobe {
-            SpaceLobe::Cosine { n, .. } => [n, DVec3::ZERO],
-            _ => [DVec3::ZERO; 2],
-        };
-        let mut busy = [false; MAX_FIELDS];
-        for j in frame.iter() {
-            busy[self.poles.slot_field.get(j).copied().unwrap_or(0) as usize] = true;
-        }
-        // A fixed pole lays the edges parallel to it along fibres, where V
-        // cannot move them across: right while their motion relative to the
-        // vertex and its frame is along the pole (a translation seen from a
-        // still vertex). Once a slot of a family moves the vertex or turns
-        // the frame (past a warped direction), the family takes the
-        // vertex's own pole (a box's vertical edges, sliding sideways as
-        // seen from a scattering vertex that had moved, made expectation's
-        // ∂I/∂tz 3–6 % off in fog); those families share one field,
-        // searched once.
-        let mut own: Option<FibreField> = None;
-        for (i, (f, rule)) in warp.fields.iter_mut().zip(&self.poles.rules).enumerate() {
-            *f = if busy[i] {
-                *own.get_or_insert_with(|| self.fibre_field(v, w, pole(v.x), ends, None))
-            } else {
-                self.fibre_field(
-                    v,
-                    w,
-                    rule.at(v.x),
-                    ends,
-                    Some(&self.poles.field_bounds[i][..]),
-                )
-            };
-        }
-        warp
-    }
-
     // ANCHOR: fibre_warp
     /// The field of the fibres from the pole `p` at `v` around `w`; the
     /// lobe ends on the great circles of normals `ends` (zero: none), where
@@ -305,11 +229,99 @@ impl Space {
         }
     }
     // ANCHOR_END: fibre_warp
+}
+
+/// The fibre warp.
+impl Warping for Space {
+    type Warp = SpaceWarp;
+
+    /// The warp at `v` around `w`: a field per pole rule. A family none of
+    /// whose slots is in `frame` (vertex and frame still) is zero unless its
+    /// fibre meets a mesh its slots move: it is left zero there, unsearched.
+    fn warp(
+        &self,
+        v: &Vertex<Self>,
+        w: DVec3,
+        _ahead: Option<Option<Hit>>,
+        frame: SlotSet,
+    ) -> SpaceWarp {
+        let still = FibreKnot {
+            cos: 1.0,
+            edge: None,
+        };
+        let blank = FibreField {
+            m: DVec3::ZERO,
+            cos: 1.0,
+            sin: 0.0,
+            e_w: DVec3::ZERO,
+            lo: still,
+            hi: still,
+        };
+        let mut warp = SpaceWarp {
+            fields: [blank; MAX_FIELDS],
+            count: self.poles.rules.len(),
+        };
+        if let SpaceLobe::Pixel { frame, rect, pixel } = v.lobe {
+            // At a camera, one family for every slot: the image's rows
+            // (pole on the camera's right axis) or its columns (pole up),
+            // whichever the pixel's moving edges cross more steeply (a
+            // crossing slides along its fibre at v_n / sin of the angle
+            // between edge and fibre; chosen once per pixel when its edges
+            // are cut, `PixelEdges::along_rows`). The stratum's sides
+            // across the fibres are the ends; the other two are fibres. See
+            // `super::camera`.
+            let [f, r, u] = frame;
+            let (pole, ends) = if self.pixel_edges().along_rows(pixel) {
+                (r, [u.cross(f + r * rect[0]), u.cross(f + r * rect[1])])
+            } else {
+                (u, [r.cross(f + u * rect[2]), r.cross(f + u * rect[3])])
+            };
+            warp.count = 1;
+            let quiet = frame
+                .is_empty()
+                .then(|| &self.poles.field_bounds[self.poles.rules.len()][..]);
+            warp.fields[0] = self.fibre_field(v, w, pole, ends, quiet);
+            return warp;
+        }
+        // A cosine lobe ends at its horizon.
+        let ends = match v.lobe {
+            SpaceLobe::Cosine { n, .. } => [n, DVec3::ZERO],
+            _ => [DVec3::ZERO; 2],
+        };
+        let mut busy = [false; MAX_FIELDS];
+        for j in frame.iter() {
+            busy[self.poles.slot_field.get(j).copied().unwrap_or(0) as usize] = true;
+        }
+        // A fixed pole lays the edges parallel to it along fibres, where V
+        // cannot move them across: right while their motion relative to the
+        // vertex and its frame is along the pole (a translation seen from a
+        // still vertex). Once a slot of a family moves the vertex or turns
+        // the frame (past a warped direction), the family takes the
+        // vertex's own pole (a box's vertical edges, sliding sideways as
+        // seen from a scattering vertex that had moved, made expectation's
+        // ∂I/∂tz 3–6 % off in fog); those families share one field,
+        // searched once.
+        let mut own: Option<FibreField> = None;
+        for (i, (f, rule)) in warp.fields.iter_mut().zip(&self.poles.rules).enumerate() {
+            *f = if busy[i] {
+                *own.get_or_insert_with(|| self.fibre_field(v, w, pole(v.x), ends, None))
+            } else {
+                self.fibre_field(
+                    v,
+                    w,
+                    rule.at(v.x),
+                    ends,
+                    Some(&self.poles.field_bounds[i][..]),
+                )
+            };
+        }
+        warp
+    }
 
     // ANCHOR: fibre_velocity
     /// One slot's direction velocity and divergence under the warp, the
     /// vertex as the slot moves it.
-    pub(super) fn fibre_velocity(
+    fn warp_velocity(
         &self,
         warp: &SpaceWarp,
         slot: usize,
@@ -348,7 +360,7 @@ impl Space {
     // ANCHOR_END: fibre_velocity
 
     /// The meshes whose motion the warp follows.
-    pub(super) fn fibre_shapes(&self, warp: &SpaceWarp, mut f: impl FnMut(u32)) {
+    fn warp_shapes(&self, warp: &SpaceWarp, mut f: impl FnMut(u32)) {
         for field in &warp.fields[..warp.count] {
             for k in [field.lo, field.hi] {
                 if let Some(e) = k.edge {
@@ -434,7 +446,7 @@ mod tests {
                 // vertex's own pole instead, another field).
                 let ends = [DVec3::Z, DVec3::ZERO];
                 let field = |quiet: bool| {
-                    let mut warp = space.fibre_warp(&v, w, SlotSet::EMPTY);
+                    let mut warp = space.warp(&v, w, None, SlotSet::EMPTY);
                     for (i, rule) in space.poles.rules.iter().enumerate() {
                         let bounds = quiet.then(|| &space.poles.field_bounds[i][..]);
                         warp.fields[i] = space.fibre_field(&v, w, rule.at(x), ends, bounds);
@@ -455,7 +467,7 @@ mod tests {
                         u: DVec3::ZERO,
                         spin: DVec3::ZERO,
                     };
-                    let f = |warp| space.fibre_velocity(&warp, j, still, w, velocity);
+                    let f = |warp| space.warp_velocity(&warp, j, still, w, velocity);
                     let (a, b) = (f(quiet), f(searched));
                     assert_eq!(a, b, "slot {j} at {x} along {w}");
                     let field = space.poles.slot_field[j] as usize;

@@ -440,7 +440,7 @@ impl BoundaryView {
 
 /// Where the integrand over directions jumps, and the warp that follows
 /// those jumps: the discontinuity machinery of a geometry.
-pub trait Boundaries: Geometry {
+pub trait Boundaries: Warping {
     /// Draws one boundary point for the directional integral at `v` (see
     /// [`Boundaries::boundary_points`] for all of them), among those that
     /// move for some slot of `view`: all of them for a slot whose vertex or
@@ -511,11 +511,15 @@ pub trait Boundaries: Geometry {
     /// starts: at the point itself its rays would slip past the
     /// neighbouring faces (a reflector's concave corner lights itself).
     fn off_boundary(&self, b: &BoundaryPoint<Self::V>, p: Prim) -> Self::V;
+}
 
-    /// The expectation method's warp of the directions at a vertex: a
-    /// continuous velocity field over directions that equals each
-    /// discontinuity's velocity at the discontinuity and the frame's at the
-    /// lobe's horizon, so no boundary term is left.
+/// The expectation method's warp of the directions at a vertex: a
+/// continuous velocity field over directions that equals each
+/// discontinuity's velocity at the discontinuity and the frame's at the
+/// lobe's horizon, so no boundary term is left. It follows the
+/// discontinuities [`Boundaries`] finds.
+pub trait Warping: Geometry {
+    /// The field at one vertex.
     type Warp;
     /// The warp at `v` around the direction `w` drawn there. `ahead`, when
     /// the caller has cast the ray already, is its first hit (`Some(None)`:

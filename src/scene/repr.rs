@@ -30,3 +30,32 @@ macro_rules! fields {
     )*};
 }
 pub(crate) use fields;
+
+/// The two conversions between a tagged enum and its file form, whose unit
+/// variants are empty struct variants there (see the module doc):
+/// `file_form!(Form <-> super::Motion; units A, B; fields C { x, y })`.
+/// Every variant is named, so a variant added to one side and not the
+/// other fails to compile.
+macro_rules! file_form {
+    ($form:ident <-> $real:ty; units $($u:ident),*; fields $($v:ident { $($f:ident),* }),*) => {
+        impl From<$form> for $real {
+            fn from(m: $form) -> Self {
+                match m {
+                    $($form::$u {} => Self::$u,)*
+                    $($form::$v { $($f),* } => Self::$v { $($f),* },)*
+                }
+            }
+        }
+
+        impl From<$real> for $form {
+            fn from(m: $real) -> Self {
+                type Real = $real;
+                match m {
+                    $(Real::$u => Self::$u {},)*
+                    $(Real::$v { $($f),* } => Self::$v { $($f),* },)*
+                }
+            }
+        }
+    };
+}
+pub(crate) use file_form;

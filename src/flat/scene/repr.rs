@@ -3,7 +3,7 @@
 //! variant of a tagged enum a struct variant, fields read through
 //! `crate::scene::repr::field`). Surfaces and phase functions have one file
 //! form for both dimensions, in `crate::scene::material`.
-use crate::scene::repr::fields;
+use crate::scene::repr::{fields, file_form};
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
@@ -66,24 +66,4 @@ pub enum Motion {
     },
 }
 
-impl From<Motion> for super::Motion {
-    fn from(m: Motion) -> Self {
-        match m {
-            Motion::TranslateX {} => Self::TranslateX,
-            Motion::TranslateY {} => Self::TranslateY,
-            Motion::Rotate { pivot } => Self::Rotate { pivot },
-            Motion::Scale { pivot } => Self::Scale { pivot },
-        }
-    }
-}
-
-impl From<super::Motion> for Motion {
-    fn from(m: super::Motion) -> Self {
-        match m {
-            super::Motion::TranslateX => Self::TranslateX {},
-            super::Motion::TranslateY => Self::TranslateY {},
-            super::Motion::Rotate { pivot } => Self::Rotate { pivot },
-            super::Motion::Scale { pivot } => Self::Scale { pivot },
-        }
-    }
-}
+file_form!(Motion <-> super::Motion; units TranslateX, TranslateY; fields Rotate { pivot }, Scale { pivot });

@@ -57,7 +57,7 @@ type Query = (DVec3, DVec3, f64, u32);
 
 /// Checks `closest_hit` and `any_hit` of `bvh` against `scan` for one
 /// query, exactly; returns the hit.
-fn agree(bvh: &TriangleBvh, scan: &LinearTriangles, q: Query) -> Option<(f64, u32)> {
+fn agree(bvh: &TriangleBvh, scan: &TriangleBvh, q: Query) -> Option<(f64, u32)> {
     let (o, d, t_max, skip) = q;
     let want = scan.closest_hit(o, d, t_max, skip);
     let got = bvh.closest_hit(o, d, t_max, skip);
@@ -120,7 +120,7 @@ fn intersect_known_cases() {
 /// (`centre`, half-size `h`), origins on a triangle (skipping it or not), random `t_max`
 /// and `skip`, unit and non-unit directions. Returns the hits seen.
 fn random_queries(tris: &[Tri], centre: DVec3, h: f64, n: usize, seed: u64) -> usize {
-    let scan = LinearTriangles::new(tris.to_vec());
+    let scan = TriangleBvh::linear(tris.to_vec());
     let bvh = TriangleBvh::new(tris.to_vec());
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let count = tris.len() as u32;
@@ -191,7 +191,7 @@ fn scaled_and_moved_scenes_agree() {
         let shift = DVec3::splat(shift);
         let mut tris = triangles(&v, &f, 0.5 * scale, shift);
         tris.extend(soup.iter().map(|t| t.map(|p| p * scale + shift)));
-        let scan = LinearTriangles::new(tris.clone());
+        let scan = TriangleBvh::linear(tris.clone());
         let bvh = TriangleBvh::new(tris.clone());
         let mut hits = 0;
         for k in 0..1500 {
@@ -233,7 +233,7 @@ fn rays_at_icosphere_edges_and_vertices_never_slip_through() {
     for (scale, shift) in [(1.0, 0.0), (1e-30, 0.0), (1e30, 0.0), (1.0, 1e6)] {
         let shift = DVec3::splat(shift);
         let tris = triangles(&v, &f, scale, shift);
-        let scan = LinearTriangles::new(tris.clone());
+        let scan = TriangleBvh::linear(tris.clone());
         let bvh = TriangleBvh::new(tris.clone());
         let w: Vec<DVec3> = v.iter().map(|&p| p * scale + shift).collect();
         // Targets exactly at the vertices and on the edges.
@@ -291,7 +291,7 @@ fn axis_rays_through_a_gridded_cube_tie_to_the_lowest_index() {
             }
         }
     }
-    let scan = LinearTriangles::new(tris.clone());
+    let scan = TriangleBvh::linear(tris.clone());
     let bvh = TriangleBvh::new(tris.clone());
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
     let mut ties = 0;
@@ -336,7 +336,7 @@ fn skip_and_t_max_are_respected() {
     let (v, f) = icosphere(2);
     let mut tris = triangles(&v, &f, 1.0, DVec3::ZERO);
     tris.extend(triangles(&v, &f, 0.5, DVec3::ZERO)); // a sphere inside
-    let scan = LinearTriangles::new(tris.clone());
+    let scan = TriangleBvh::linear(tris.clone());
     let bvh = TriangleBvh::new(tris.clone());
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(23);
     for _ in 0..500 {
@@ -363,7 +363,7 @@ fn skip_and_t_max_are_respected() {
 fn degenerate_lists_and_queries() {
     let (v, f) = icosphere(1);
     let tris = triangles(&v, &f, 1.0, DVec3::ZERO);
-    let scan = LinearTriangles::new(tris.clone());
+    let scan = TriangleBvh::linear(tris.clone());
     let bvh = TriangleBvh::new(tris);
     assert_eq!((bvh.len(), scan.len()), (80, 80));
     for q in [
@@ -411,7 +411,7 @@ fn degenerate_lists_and_queries() {
         agree(&bvh, &scan, q);
     }
     let empty = TriangleBvh::new(Vec::new());
-    assert!(empty.is_empty() && LinearTriangles::new(Vec::new()).is_empty());
+    assert!(empty.is_empty() && TriangleBvh::linear(Vec::new()).is_empty());
     assert_eq!(empty.closest_hit(DVec3::ZERO, DVec3::X, 1.0, NONE), None);
     assert!(!empty.any_hit(DVec3::ZERO, DVec3::X, 1.0, NONE));
     // Non-finite triangles are never hit, small and large lists alike.
@@ -435,7 +435,7 @@ fn degenerate_lists_and_queries() {
     for n in [0, 40] {
         odd.extend((0..n).map(|i| wall(3.0 + i as f64)));
         let bvh = TriangleBvh::new(odd.clone());
-        let scan = LinearTriangles::new(odd.clone());
+        let scan = TriangleBvh::linear(odd.clone());
         assert_eq!(bvh.len(), odd.len());
         for d in [DVec3::X, DVec3::ONE, -DVec3::X] {
             agree(&bvh, &scan, (DVec3::ZERO, d, f64::INFINITY, NONE));

@@ -6,7 +6,7 @@
 //! once), fields read through `crate::scene::repr::field` so that errors
 //! name them. Surfaces and phase functions have one file form for both
 //! dimensions, in `crate::scene::material`.
-use crate::scene::repr::fields;
+use crate::scene::repr::{fields, file_form};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
@@ -38,29 +38,7 @@ pub enum Motion {
     },
 }
 
-impl From<Motion> for super::Motion {
-    fn from(m: Motion) -> Self {
-        match m {
-            Motion::TranslateX {} => Self::TranslateX,
-            Motion::TranslateY {} => Self::TranslateY,
-            Motion::TranslateZ {} => Self::TranslateZ,
-            Motion::Rotate { axis, pivot } => Self::Rotate { axis, pivot },
-            Motion::Scale { pivot } => Self::Scale { pivot },
-        }
-    }
-}
-
-impl From<super::Motion> for Motion {
-    fn from(m: super::Motion) -> Self {
-        match m {
-            super::Motion::TranslateX => Self::TranslateX {},
-            super::Motion::TranslateY => Self::TranslateY {},
-            super::Motion::TranslateZ => Self::TranslateZ {},
-            super::Motion::Rotate { axis, pivot } => Self::Rotate { axis, pivot },
-            super::Motion::Scale { pivot } => Self::Scale { pivot },
-        }
-    }
-}
+file_form!(Motion <-> super::Motion; units TranslateX, TranslateY, TranslateZ; fields Rotate { axis, pivot }, Scale { pivot });
 
 #[derive(Clone, Copy, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
