@@ -65,6 +65,7 @@ fn with_occluders(occluders: Vec<Shape>, motions: &[(&str, Motion)]) -> Scene {
                 name: format!("{}_{n}", o.name),
                 shape: o.name.clone(),
                 motion: *m,
+                bounds: None,
             });
         }
     }

@@ -60,6 +60,7 @@ pub mod image_io;
 pub mod job;
 pub mod mesh;
 pub mod method;
+pub mod optimize;
 pub mod path;
 #[cfg(feature = "figures")]
 pub mod plot;

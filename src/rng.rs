@@ -40,6 +40,17 @@ pub fn free_path(ks: f64, rng: &mut PathRng) -> f64 {
     }
 }
 
+/// A seed for one independent run inside a larger one (an optimiser's
+/// iteration, measurement and batch): distinct `parts` give unrelated
+/// streams, the same parts the same stream.
+pub fn derive_seed(seed: u64, parts: &[u64]) -> u64 {
+    parts
+        .iter()
+        .fold(mix64(seed ^ 0x6F70_7469_6D69_7365), |h, &p| {
+            mix64(h ^ mix64(p))
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -881,6 +881,7 @@ fn a_pivot_far_from_its_shape_is_refused() {
             axis: DVec3::Z,
             pivot: Some(DVec3::new(far, 0.0, 1.0)),
         },
+        bounds: None,
     };
     let scene =
         |far| geosens::mesh::Scene::new(vec![lamp(), square.clone()], vec![spin(far)], up());

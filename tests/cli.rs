@@ -561,6 +561,7 @@ fn mesh_scenes() -> [(&'static str, geosens::mesh::Scene, f64, Vec<f64>); 2] {
             name: (*n).into(),
             shape: "box".into(),
             motion: m,
+            bounds: None,
         })
         .collect();
     let cube = box_shape("box", b.corners(), Surface::Absorber, None);

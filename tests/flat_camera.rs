@@ -40,6 +40,7 @@ fn scene() -> Arc<Scene> {
         name: name.into(),
         shape: "occ".into(),
         motion,
+        bounds: None,
     })
     .to_vec();
     let camera = Sensor::Camera {

@@ -27,6 +27,7 @@ fn parameter(name: &str, shape: &str, motion: Motion) -> Parameter {
         name: name.into(),
         shape: shape.into(),
         motion,
+        bounds: None,
     }
 }
 

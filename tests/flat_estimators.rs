@@ -280,6 +280,7 @@ fn lamp_over_reflector(
             name: p.into(),
             shape: name.into(),
             motion,
+            bounds: None,
         })
         .collect();
     let sensor = Sensor::Irradiance {

@@ -212,6 +212,7 @@ fn up_scene(width: u32) -> Arc<Scene> {
         name: name.into(),
         shape: "tri".into(),
         motion,
+        bounds: None,
     })
     .to_vec();
     let camera = Camera {

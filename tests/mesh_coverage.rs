@@ -102,6 +102,7 @@ fn scenes() -> Vec<(&'static str, Arc<Scene>, f64, [f64; 5])> {
                 name: (*n).into(),
                 shape: "occ".into(),
                 motion: m,
+                bounds: None,
             })
             .collect();
         Arc::new(Scene::new(vec![lamp.clone(), occ], parameters, sensor).unwrap())

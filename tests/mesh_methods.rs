@@ -14,6 +14,7 @@ fn params(shape: &str, motions: &[(&str, Motion)]) -> Vec<Parameter> {
             name: (*n).into(),
             shape: shape.into(),
             motion: *m,
+            bounds: None,
         })
         .collect()
 }
@@ -195,6 +196,7 @@ fn occluders_match_the_closed_forms() {
                 name: (*n).into(),
                 shape: "occ".into(),
                 motion: m,
+                bounds: None,
             })
             .collect();
         let scene = Arc::new(Scene::new(vec![lamp(), shape], parameters, up()).unwrap());
@@ -240,6 +242,7 @@ fn floor_radiance_and_sensor_gradient_match_the_closed_forms() {
             name: (*n).into(),
             shape: "occ".into(),
             motion: m,
+            bounds: None,
         })
         .collect();
     let albedo = 0.7;
@@ -603,6 +606,7 @@ fn a_moving_lamp_and_scaled_scenes_match_the_closed_forms() {
                 name: (*n).into(),
                 shape: "occ".into(),
                 motion: m,
+                bounds: None,
             })
             .collect();
         let scene =
@@ -862,6 +866,7 @@ fn a_small_moving_mesh_keeps_its_error_bars_beside_a_large_one() {
                 name: (*n).into(),
                 shape: "occ".into(),
                 motion: m,
+                bounds: None,
             })
             .collect();
         if with_ball {

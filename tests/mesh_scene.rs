@@ -315,6 +315,7 @@ fn a_large_mesh_validates_and_moves() {
         name: "lift".into(),
         shape: "terrain".into(),
         motion: Motion::TranslateZ,
+        bounds: None,
     }];
     let sensor = Sensor::Irradiance {
         point: DVec3::new(0.0, 0.0, 0.1),

@@ -540,6 +540,7 @@ fn corners_scene() -> Plane {
         name: name.into(),
         shape: shape.into(),
         motion,
+        bounds: None,
     };
     let parameters = vec![
         parameter("block_tx", "block", Motion::TranslateX),

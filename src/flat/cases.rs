@@ -23,6 +23,7 @@ fn parameter(shape: &str, motion: Motion) -> Vec<Parameter> {
         name: "p".into(),
         shape: shape.into(),
         motion,
+        bounds: None,
     }]
 }
 
@@ -143,6 +144,7 @@ pub fn vault(n: usize, shift: f64) -> Result<Scene, Error> {
         name: name.into(),
         shape: shape.into(),
         motion,
+        bounds: None,
     })
     .collect();
     Scene::new(vec![lamp(), occluder, vault], parameters, up())

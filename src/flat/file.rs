@@ -31,7 +31,9 @@
 //! for a parse error the line, the column and the field at fault.
 use super::scene::{Parameter, Scene, Sensor, Shape};
 use crate::error::Error;
-use crate::scene::file::{json_error, parse_file};
+use crate::optimize::Study;
+use crate::scene::file::{first_sensor, in_file, json_error, objective_of, parse_file};
+use crate::scene::objective::{Measurement, Objective};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -44,8 +46,15 @@ pub struct SceneFile {
     /// The parameters whose sensitivities are wanted (none if absent).
     #[serde(default)]
     pub parameters: Vec<Parameter>,
-    /// What is measured.
-    pub sensor: Sensor,
+    /// What is measured (the first measurement's sensor if absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<Sensor>,
+    /// For an optimisation: what is measured, with targets and weights.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub measurements: Vec<Measurement<Sensor>>,
+    /// For an optimisation: what is made least or greatest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective: Option<Objective>,
 }
 
 impl SceneFile {
@@ -54,13 +63,22 @@ impl SceneFile {
         SceneFile {
             shapes: scene.shapes().to_vec(),
             parameters: scene.parameters().to_vec(),
-            sensor: scene.sensor(),
+            sensor: Some(scene.sensor()),
+            measurements: Vec::new(),
+            objective: None,
         }
     }
 
     /// Validates the contents into a scene.
     pub fn into_scene(self) -> Result<Scene, Error> {
-        Scene::new(self.shapes, self.parameters, self.sensor)
+        let sensor = first_sensor(self.sensor, &self.measurements)?;
+        Scene::new(self.shapes, self.parameters, sensor)
+    }
+
+    /// Validates the contents into an optimisation problem.
+    pub fn into_study(self) -> Result<Study<Scene>, Error> {
+        let (measurements, kind) = (self.measurements.clone(), objective_of(&self.objective)?);
+        Study::new(self.into_scene()?, measurements, kind)
     }
 }
 
@@ -68,6 +86,22 @@ impl SceneFile {
 /// `.json` (any case). Errors name the file.
 pub fn load(path: &Path) -> Result<Scene, Error> {
     parse_file(path, from_toml, from_json)
+}
+
+/// Reads the optimisation problem in the scene file at `path` (its
+/// `[objective]` and `[[measurements]]`). Errors name the file.
+pub fn load_study(path: &Path) -> Result<Study<Scene>, Error> {
+    parse_file(path, parse_toml, parse_json)?
+        .into_study()
+        .map_err(|e| in_file(path, e))
+}
+
+fn parse_toml(text: &str) -> Result<SceneFile, Error> {
+    toml::from_str(text).map_err(|e| Error::Scene(e.to_string().trim_end().to_string()))
+}
+
+fn parse_json(text: &str) -> Result<SceneFile, Error> {
+    serde_json::from_str(text).map_err(|e| json_error(text, &e))
 }
 
 /// Parses and validates a TOML scene.

@@ -31,6 +31,7 @@ use crate::path::estimator::{DerivativeEstimator, Scheme};
 use crate::path::thin_media::chord_bound;
 use crate::path::walk::{Frame, Vertex};
 use crate::path::{MovingVertex, NO_PRIM, Surface, Warping};
+use crate::scene::pose::pose;
 use glam::DVec2;
 use std::sync::Arc;
 
@@ -89,6 +90,28 @@ impl Model for Scene {
     }
     fn displaced(&self, j: usize, delta: f64) -> Result<Self, Error> {
         Scene::displaced(self, j, delta)
+    }
+    type Sensor = Sensor;
+    fn sensor(&self) -> Sensor {
+        Scene::sensor(self)
+    }
+    fn with_sensor(&self, sensor: Sensor) -> Result<Self, Error> {
+        Scene::new(self.shapes().to_vec(), self.parameters().to_vec(), sensor)
+    }
+    fn posed(&self, offsets: &[f64]) -> Result<Self, Error> {
+        let params = self.parameters();
+        let owner: Vec<u32> = (0..params.len()).map(|j| self.parameter_shape(j)).collect();
+        let (shapes, params) = pose(self.shapes(), params, &owner, offsets)?;
+        Scene::new(shapes, params, self.sensor())
+    }
+    fn bounds(&self, j: usize) -> Option<[f64; 2]> {
+        self.parameters()[j].bounds
+    }
+    fn pixels(sensor: &Sensor) -> u64 {
+        match sensor {
+            Sensor::Camera { width, .. } => u64::from(*width),
+            _ => 1,
+        }
     }
     fn derivative_caveats(plane: &Plane, _gradient: bool) -> Vec<(Quantity, String)> {
         ties(plane.scene())

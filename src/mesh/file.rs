@@ -46,7 +46,11 @@
 //! relative to the current directory.
 use super::scene::{Medium, Parameter, Scene, Sensor, Shape, Surface};
 use crate::error::Error;
-use crate::scene::file::{MAX_SCENE_BYTES, in_file, json_error, parse_file, read_bytes_capped};
+use crate::optimize::Study;
+use crate::scene::file::{
+    MAX_SCENE_BYTES, first_sensor, in_file, json_error, objective_of, parse_file, read_bytes_capped,
+};
+use crate::scene::objective::{Measurement, Objective};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -127,7 +131,14 @@ pub struct MeshFile {
     #[serde(default)]
     pub parameters: Vec<Parameter>,
     /// What is measured.
-    pub sensor: Sensor,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<Sensor>,
+    /// For an optimisation: what is measured, with targets and weights.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub measurements: Vec<Measurement<Sensor>>,
+    /// For an optimisation: what is made least or greatest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective: Option<Objective>,
 }
 
 impl MeshFile {
@@ -149,7 +160,9 @@ impl MeshFile {
                 })
                 .collect(),
             parameters: scene.parameters().to_vec(),
-            sensor: scene.sensor(),
+            sensor: Some(scene.sensor()),
+            measurements: Vec::new(),
+            objective: None,
         }
     }
 
@@ -161,8 +174,26 @@ impl MeshFile {
             .into_iter()
             .map(|s| s.into_shape(base))
             .collect::<Result<Vec<_>, _>>()?;
-        Scene::new(shapes, self.parameters, self.sensor)
+        let sensor = first_sensor(self.sensor, &self.measurements)?;
+        Scene::new(shapes, self.parameters, sensor)
     }
+
+    /// Reads the OBJ files (relative to `base`) and validates the contents
+    /// into an optimisation problem.
+    pub fn into_study(self, base: &Path) -> Result<Study<Scene>, Error> {
+        let (measurements, kind) = (self.measurements.clone(), objective_of(&self.objective)?);
+        Study::new(self.into_scene(base)?, measurements, kind)
+    }
+}
+
+/// Reads the optimisation problem in the scene file at `path` (its
+/// `[objective]` and `[[measurements]]`); OBJ paths are relative to its
+/// directory. Errors name the file.
+pub fn load_study(path: &Path) -> Result<Study<Scene>, Error> {
+    let base = path.parent().unwrap_or(Path::new(""));
+    parse_file(path, parse_toml, parse_json)?
+        .into_study(base)
+        .map_err(|e| in_file(path, e))
 }
 
 /// Reads the scene file at `path`: TOML if it ends in `.toml`, JSON if in

@@ -292,6 +292,7 @@ mod tests {
             name: "box_tx".into(),
             shape: "box".into(),
             motion: Motion::TranslateX,
+            bounds: None,
         }];
         let scene = Scene::new(shapes, parameters, crate::mesh::cases::up()).unwrap();
         let space = Space::new(Arc::new(scene));

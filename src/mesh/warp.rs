@@ -393,6 +393,7 @@ mod tests {
             name: name.into(),
             shape: shape.into(),
             motion,
+            bounds: None,
         };
         let scene = Scene::new(
             vec![

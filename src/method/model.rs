@@ -66,6 +66,20 @@ pub trait Model: Sized + Send + Sync + 'static {
     /// The scene with parameter `j` changed by `delta`, validated again.
     fn displaced(&self, j: usize, delta: f64) -> Result<Self, Error>;
 
+    /// What the scene measures (flatland's or 3D's sensor).
+    type Sensor: Copy + Send + Sync + std::fmt::Debug;
+    /// The scene's sensor.
+    fn sensor(&self) -> Self::Sensor;
+    /// The same shapes and parameters seen by `sensor`, validated again.
+    fn with_sensor(&self, sensor: Self::Sensor) -> Result<Self, Error>;
+    /// The scene at `offsets` from this pose, one per parameter
+    /// ([`crate::scene::pose`]), validated again.
+    fn posed(&self, offsets: &[f64]) -> Result<Self, Error>;
+    /// Parameter `j`'s bounds, if any (offsets from this pose).
+    fn bounds(&self, j: usize) -> Option<[f64; 2]>;
+    /// The pixel count of a camera sensor (1 for a probe).
+    fn pixels(sensor: &Self::Sensor) -> u64;
+
     /// Where `I` (or, with `gradient`, the sensor's gradient) may not be
     /// differentiable, for the derivative methods.
     fn derivative_caveats(geometry: &Self::Geometry, gradient: bool) -> Vec<(Quantity, String)>;

@@ -241,6 +241,34 @@ fn key_before(text: &str, line: usize, column: usize) -> Option<String> {
     key
 }
 
+/// The scene's sensor: the file's `[sensor]`, else its first measurement's.
+pub(crate) fn first_sensor<S: Copy>(
+    sensor: Option<S>,
+    measurements: &[crate::scene::objective::Measurement<S>],
+) -> Result<S, Error> {
+    sensor
+        .or_else(|| measurements.first().map(|m| m.sensor))
+        .ok_or_else(|| {
+            Error::Scene(
+                "missing field `sensor`: a scene needs a [sensor] or [[measurements]]".into(),
+            )
+        })
+}
+
+/// The file's objective: refused when absent (the caller asked for an
+/// optimisation).
+pub(crate) fn objective_of(
+    objective: &Option<crate::scene::objective::Objective>,
+) -> Result<crate::scene::objective::ObjectiveKind, Error> {
+    objective.map(|o| o.kind).ok_or_else(|| {
+        Error::Scene(
+            "missing table [objective]: an optimisation needs `kind = \"least_squares\"`, \
+             \"maximize\" or \"minimize\""
+                .into(),
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -21,6 +21,10 @@ pub struct Parameter<M> {
     pub shape: String,
     /// How it moves it.
     pub motion: M,
+    /// For an optimisation, the interval its offset from the file's pose
+    /// stays in (`[lo, hi]`, `lo ≤ 0 ≤ hi`); none: unbounded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bounds: Option<[f64; 2]>,
 }
 
 /// The parameters with their motions resolved by `resolve(parameter,
@@ -54,12 +58,16 @@ pub(crate) fn resolve_parameters<M>(
                 p.name, p.shape
             ));
         };
+        if let Some(b) = p.bounds {
+            super::objective::check_bounds(&p.name, b)?;
+        }
         let motion = resolve(p, k)?;
         parameter_shape.push(k as u32);
         resolved.push(Parameter {
             name: p.name.clone(),
             shape: p.shape.clone(),
             motion,
+            bounds: p.bounds,
         });
     }
     Ok((resolved, parameter_shape))

@@ -327,6 +327,7 @@ fn mesh_table(cfg: &RunConfig, out: &mut impl Write) -> Result<(), Box<dyn std::
             name: (*n).into(),
             shape: "box".into(),
             motion: m,
+            bounds: None,
         })
         .collect();
     let cube = box_shape("box", b.corners(), Surface::Absorber, None);

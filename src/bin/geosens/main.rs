@@ -17,6 +17,10 @@
 //!   `geosens merge FILE… [--json] [--out DIR]` prints (or writes) what the
 //!   single run would have, bit for bit (`--missing` lists the shards no
 //!   FILE holds instead, for a rerun);
+//! - `geosens optimize --scene FILE --method M [--iterations N]
+//!   [--paths-per-step N] [--step F] [--json]` fits the parameters of a
+//!   scene with `[objective]` and `[[measurements]]` (or designs them), one
+//!   record per iteration;
 //! - `geosens compare` runs the four Monte Carlo methods on the paper's thin
 //!   and thick rods at a few probes and prints them beside the exact solution,
 //!   then every method on two 3D occluder scenes beside their closed forms,
@@ -65,6 +69,10 @@ enum Command {
     /// Merge the states of every shard of one run (`--shard I/N --state
     /// FILE`) and print what the single run prints.
     Merge(MergeArgs),
+    /// Fit a scene's parameters to its measurements' targets, or make a
+    /// weighted sum of them greatest or least (`[objective]`), by stochastic
+    /// gradient descent with one method's gradients.
+    Optimize(optimize::OptimizeArgs),
 }
 
 /// `--shard I/N --state FILE`, shared by the estimation commands.
@@ -270,6 +278,7 @@ fn exact_result(rod: &Rod, probe: &Probe) -> Result<RunResult, Error> {
 }
 
 mod commands;
+mod optimize;
 mod output;
 mod render;
 mod survey;
@@ -284,6 +293,7 @@ fn main() -> ExitCode {
         Command::Mesh(args) => commands::mesh_command(args, &mut out),
         Command::Render(args) => render::render_command(args, &mut out),
         Command::Merge(args) => commands::merge_command(args, &mut out),
+        Command::Optimize(args) => optimize::optimize_command(args, &mut out),
     };
     match result.and_then(|()| Ok(out.flush()?)) {
         Ok(()) => ExitCode::SUCCESS,

@@ -83,6 +83,37 @@ impl Shape {
     }
 }
 
+impl crate::scene::pose::Posable for Shape {
+    type V = DVec2;
+    fn vertices_mut(&mut self) -> &mut [DVec2] {
+        &mut self.vertices
+    }
+}
+
+impl crate::scene::pose::Pose for Motion {
+    type V = DVec2;
+    fn apply(&self, q: DVec2, delta: f64) -> DVec2 {
+        Motion::apply(self, q, delta)
+    }
+    fn translation(&self, delta: f64) -> Option<DVec2> {
+        match self {
+            Motion::TranslateX | Motion::TranslateY => Some(self.apply(DVec2::ZERO, delta)),
+            _ => None,
+        }
+    }
+    fn pivot_moved(&self, d: DVec2) -> Motion {
+        match *self {
+            Motion::Rotate { pivot } => Motion::Rotate {
+                pivot: Some(pivot.unwrap_or(DVec2::ZERO) + d),
+            },
+            Motion::Scale { pivot } => Motion::Scale {
+                pivot: Some(pivot.unwrap_or(DVec2::ZERO) + d),
+            },
+            m => m,
+        }
+    }
+}
+
 /// How a parameter moves its shape.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(from = "repr::Motion", into = "repr::Motion")]

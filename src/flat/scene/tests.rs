@@ -33,6 +33,7 @@ fn a_valid_scene_resolves_pivots_and_normals() {
             name: "spin".into(),
             shape: "box".into(),
             motion: Motion::Rotate { pivot: None },
+            bounds: None,
         }],
         irradiance(),
     )
@@ -75,6 +76,7 @@ fn bad_scenes_are_rejected_with_a_reason() {
         name: "p".into(),
         shape: "nope".into(),
         motion: Motion::TranslateX,
+        bounds: None,
     };
     assert!(err(vec![ok()], vec![p], irradiance()).contains("does not exist"));
     let inside = Sensor::Irradiance {

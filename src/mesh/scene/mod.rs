@@ -124,6 +124,40 @@ impl Shape {
     }
 }
 
+impl crate::scene::pose::Posable for Shape {
+    type V = DVec3;
+    fn vertices_mut(&mut self) -> &mut [DVec3] {
+        &mut self.vertices
+    }
+}
+
+impl crate::scene::pose::Pose for Motion {
+    type V = DVec3;
+    fn apply(&self, q: DVec3, delta: f64) -> DVec3 {
+        Motion::apply(self, q, delta)
+    }
+    fn translation(&self, delta: f64) -> Option<DVec3> {
+        match self {
+            Motion::TranslateX | Motion::TranslateY | Motion::TranslateZ => {
+                Some(self.apply(DVec3::ZERO, delta))
+            }
+            _ => None,
+        }
+    }
+    fn pivot_moved(&self, d: DVec3) -> Motion {
+        match *self {
+            Motion::Rotate { axis, pivot } => Motion::Rotate {
+                axis,
+                pivot: Some(pivot.unwrap_or(DVec3::ZERO) + d),
+            },
+            Motion::Scale { pivot } => Motion::Scale {
+                pivot: Some(pivot.unwrap_or(DVec3::ZERO) + d),
+            },
+            m => m,
+        }
+    }
+}
+
 /// How a parameter moves its mesh (with its medium). File form:
 /// `{ kind = "translate_x" }` (`_y`, `_z`), `{ kind = "rotate", axis = [x, y,
 /// z], pivot = [x, y, z] }`, `{ kind = "scale", pivot = [x, y, z] }` (pivots

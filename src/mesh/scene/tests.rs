@@ -89,6 +89,7 @@ fn param(name: &str, shape: &str, motion: Motion) -> Parameter {
         name: name.into(),
         shape: shape.into(),
         motion,
+        bounds: None,
     }
 }
 
