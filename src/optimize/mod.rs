@@ -26,7 +26,8 @@ use std::collections::BTreeMap;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Optimizer {
     /// Adam (Kingma & Ba 2015): per-parameter steps normalised by the
-    /// gradient's running scale, `step / √(1 + t/τ)` with τ = 50.
+    /// gradient's running scale, `step / (1 + t/τ)` with τ = 50 (its noise
+    /// floor is proportional to the step, so the step must fall).
     Adam,
     /// Gradient descent, `step / (1 + t/τ)^0.75` with τ = 50 (the
     /// Robbins–Monro conditions: Σ αₜ = ∞, Σ αₜ² < ∞).
@@ -60,6 +61,11 @@ pub struct Record {
     pub iteration: u32,
     /// The parameters' offsets from the file's pose, by name.
     pub parameters: BTreeMap<String, f64>,
+    /// The mean of the iterates over the last half of the run so far
+    /// (iterations ⌈t/2⌉ to t; Polyak–Ruppert tail averaging): the answer
+    /// to report, its noise √(t/2) times smaller than the iterate's once
+    /// the iterates hover about the optimum.
+    pub average: BTreeMap<String, f64>,
     /// The loss at this iterate.
     pub loss: MeanErr,
     /// Its gradient, by parameter name.
@@ -70,8 +76,8 @@ pub struct Record {
     pub seconds: f64,
     /// Of which the sampling.
     pub sampling_seconds: f64,
-    /// What the step did beyond the rule (clamped to a bound, shortened
-    /// to keep the scene valid).
+    /// What the step that led to this iterate did beyond the rule
+    /// (clamped to a bound, shortened to keep the scene valid).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
 }
@@ -129,7 +135,7 @@ impl Stepper {
         let t = f64::from(self.t);
         match self.optimizer {
             Optimizer::Adam => {
-                let alpha = self.step / (1.0 + (t - 1.0) / TAU).sqrt();
+                let alpha = self.step / (1.0 + (t - 1.0) / TAU);
                 (0..g.len())
                     .map(|j| {
                         self.m[j] = BETA1 * self.m[j] + (1.0 - BETA1) * g[j];
@@ -166,7 +172,9 @@ pub fn optimize<S: Model>(
     let mut records = Vec::new();
     let mut posed = study.posed(&theta)?;
     let mut notes = Vec::new();
+    let mut history: Vec<Vec<f64>> = Vec::new();
     for iteration in 0..=settings.iterations {
+        history.push(theta.clone());
         let start = std::time::Instant::now();
         let sampling = Sampling {
             seed: crate::rng::derive_seed(settings.sampling.seed, &[u64::from(iteration)]),
@@ -177,6 +185,7 @@ pub fn optimize<S: Model>(
         let mut record = Record {
             iteration,
             parameters: names.iter().cloned().zip(theta.iter().copied()).collect(),
+            average: names.iter().cloned().zip(tail_average(&history)).collect(),
             loss: e.loss.into(),
             gradient: names
                 .iter()
@@ -211,6 +220,15 @@ pub fn optimize<S: Model>(
         }
     }
     Ok(records)
+}
+
+/// The mean of the last half of `history` (its last ⌈n/2⌉ entries).
+fn tail_average(history: &[Vec<f64>]) -> Vec<f64> {
+    let tail = &history[history.len() / 2..];
+    let n = tail.len() as f64;
+    (0..tail[0].len())
+        .map(|j| tail.iter().map(|t| t[j]).sum::<f64>() / n)
+        .collect()
 }
 
 /// `theta + delta` clamped to the bounds and shortened (halved) until the
