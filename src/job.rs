@@ -32,6 +32,7 @@
 use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::method::{Method, Problem};
+use crate::optimize::Study;
 use crate::report::{Header, Report, RodProbe, rod_exact, rod_quantities};
 use crate::runner::{RunConfig, RunResult, run_with_progress};
 use crate::stats::Estimate;
@@ -132,6 +133,23 @@ impl SceneSource {
         match self {
             SceneSource::File(p) => mesh::file::load(p),
             SceneSource::Json(text) => mesh::file::from_json(text),
+        }
+    }
+
+    /// The flatland scene's optimisation problem (its `[objective]` and
+    /// `[[measurements]]`).
+    pub fn flat_study(&self) -> Result<Study<flat::Scene>, Error> {
+        match self {
+            SceneSource::File(p) => flat::file::load_study(p),
+            SceneSource::Json(text) => flat::file::study_from_json(text),
+        }
+    }
+
+    /// The 3D scene's optimisation problem.
+    pub fn mesh_study(&self) -> Result<Study<mesh::Scene>, Error> {
+        match self {
+            SceneSource::File(p) => mesh::file::load_study(p),
+            SceneSource::Json(text) => mesh::file::study_from_json(text),
         }
     }
 

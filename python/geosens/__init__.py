@@ -12,6 +12,9 @@ subcommand runs and returns what ``--json`` prints, parsed::
   bit for the same seed but for ``"seconds"``;
 - :func:`render` returns the JSON line of ``geosens render`` with the images
   added under ``"images"`` as float64 arrays of shape (height, width);
+- :func:`optimize` runs ``geosens optimize --json`` on a scene with
+  ``measurements`` and an ``objective`` and returns its records, one dict
+  per iteration;
 - with ``shard=(i, n)`` each returns shard ``i`` of ``n`` of the run instead:
   its exact state, a dict (``--shard i/n --state FILE``), and :func:`merge`
   turns the states of all ``n`` shards into what the single run returns.
@@ -55,7 +58,7 @@ import numpy as np
 
 from . import _geosens
 
-__all__ = ["rod", "flat", "mesh", "render", "merge", "__version__"]
+__all__ = ["rod", "flat", "mesh", "render", "merge", "optimize", "__version__"]
 
 __version__: str = _geosens.__version__
 
@@ -161,12 +164,14 @@ def _scene(scene: Scene) -> Tuple[Optional[str], Optional[str]]:
     )
 
 
-def _result(outcome: Tuple[str, str, List[str], list]) -> Dict[str, Any]:
+def _result(outcome: Tuple[str, str, List[str], list], stacklevel: int = 3) -> Dict[str, Any]:
     """The Python result of a Rust call: its JSON parsed, its warnings
-    issued, a rendering's images as arrays."""
+    issued (``stacklevel``: at the line of the user's code, which called the
+    public function that called this one, 3, or the helper that did, 4),
+    a rendering's images as arrays."""
     kind, text, warns, images = outcome
     for w in warns:
-        warnings.warn(w.removeprefix("warning: "), RuntimeWarning, stacklevel=3)
+        warnings.warn(w.removeprefix("warning: "), RuntimeWarning, stacklevel=stacklevel)
     result = json.loads(text)
     if kind == "image":
         result["images"] = {
@@ -269,7 +274,9 @@ def _scene_run(
             _fd_step(fd_step),
             _shard(shard),
             _stop(stop),
-        )
+        ),
+        # user → flat/mesh → _scene_run → _result
+        stacklevel=4,
     )
 
 
@@ -397,3 +404,99 @@ def merge(states: Sequence[StateLike]) -> Dict[str, Any]:
                 f"not {type(s).__name__}"
             )
     return _result(_geosens.merge(items))
+
+
+def optimize(
+    scene: Scene,
+    method: str,
+    *,
+    optimizer: str = "adam",
+    iterations: int = 100,
+    paths_per_step: int = 16384,
+    step: float = 0.02,
+    batches: int = 8,
+    fd_step: Optional[float] = None,
+    tolerance: float = 0.0,
+    seed: int = 1,
+    threads: int = 0,
+    progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
+    stop: Optional[Stop] = None,
+) -> List[Dict[str, Any]]:
+    """``geosens optimize --json``: an inverse problem or a design by
+    stochastic gradient descent on a scene's parameters, from the scene's
+    pose; one record per iteration, the command line's JSON lines parsed
+    (identical for the same seed but for the ``"seconds"`` keys).
+
+    Args:
+        scene: a scene file (TOML or JSON) or a dict of its schema, flatland
+            or 3D (by its points), with ``measurements`` (a list of dicts:
+            a sensor with ``target``, ``weight`` or ``sigma``), an
+            ``objective`` (``{"kind": "least_squares"}``, ``"maximize"`` or
+            ``"minimize"``) and parameters, optionally with ``bounds``
+            (offsets from the pose).
+        method: the method that estimates the gradient: expectation,
+            rendering, transport or fd (intensity: the loss only).
+        optimizer: ``"adam"`` or ``"sgd"`` (gradient descent with a
+            decreasing step).
+        iterations: iterations at most (records: one more, iteration 0 is
+            the start).
+        paths_per_step: paths per measurement (a camera's: per pixel) and
+            iteration.
+        step: the first step: Adam's in parameter units (scene units,
+            radians), gradient descent's multiplier of the gradient.
+        batches: independent batches the paths split into (at least 2:
+            the gradient's products are taken between them, so it is
+            unbiased).
+        fd_step: the finite differences' half step (``method="fd"``).
+        tolerance: stop once no parameter moves more than this in a step
+            (0: never).
+        seed, threads: as for :func:`rod`; the records do not depend on
+            ``threads``.
+        progress: called with each record as it is made, on the calling
+            thread (a notebook's live plot); returning ``False`` (not
+            merely a false value) ends the run after that record, and an
+            exception it raises ends it and propagates.
+        stop: as for :func:`rod`; Ctrl-C and ``stop`` end the run after
+            the iteration under way, and the ``KeyboardInterrupt`` raised
+            carries the records made before as its ``records`` attribute.
+
+    Returns:
+        The records: ``{"iteration", "parameters": {name: offset}, "loss":
+        {"mean", "stderr"}, "gradient": {name: {"mean", "stderr"}},
+        "paths", "seconds", "sampling_seconds"}`` and ``"notes"`` (what a
+        step did beyond the rule: clamped to bounds, shortened to keep the
+        scene valid) when there are any.
+
+    Raises:
+        ValueError: bad input, with the command line's message (a missing
+            ``target``, reversed ``bounds``, …).
+    """
+    path, text = _scene(scene)
+    records: List[Dict[str, Any]] = []
+
+    def each(line: str) -> bool:
+        record = json.loads(line)
+        records.append(record)
+        return progress is None or progress(record) is not False
+
+    try:
+        _geosens.optimize(
+            path,
+            text,
+            method,
+            optimizer,
+            _uint("iterations", iterations),
+            _uint("paths_per_step", paths_per_step),
+            _real("step", step),
+            _uint("batches", batches),
+            _fd_step(fd_step),
+            _real("tolerance", tolerance),
+            _uint("seed", seed),
+            _uint("threads", threads),
+            each,
+            _stop(stop),
+        )
+    except KeyboardInterrupt as e:
+        e.records = records  # type: ignore[attr-defined]
+        raise
+    return records

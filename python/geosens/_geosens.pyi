@@ -23,3 +23,9 @@ def render(
     stop: Optional[Callable[[], Any]],
 ) -> _Outcome: ...
 def merge(states: List[Tuple[str, Optional[str], Optional[str]]]) -> _Outcome: ...
+def optimize(
+    path: Optional[str], json: Optional[str], method: str, optimizer: str,
+    iterations: int, paths_per_step: int, step: float, batches: int,
+    fd_step: Optional[float], tolerance: float, seed: int, threads: int,
+    each: Optional[Callable[[str], Any]], stop: Optional[Callable[[], Any]],
+) -> List[str]: ...

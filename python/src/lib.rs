@@ -1,8 +1,9 @@
 //! `geosens._geosens`: the Rust side of the `geosens` Python package, a thin
 //! layer over the library's jobs ([`geosens::job`]), printing
-//! ([`geosens::report`]) and shards ([`geosens::shard`]). Every function
-//! returns the same JSON text as the command line's `--json` line (or a
-//! shard's state), which `geosens/__init__.py` turns into Python objects;
+//! ([`geosens::report`]), shards ([`geosens::shard`]) and optimisation
+//! ([`geosens::optimize`]). Every function returns the same JSON text as
+//! the command line's `--json` line (`optimize`: lines; or a shard's
+//! state), which `geosens/__init__.py` turns into Python objects;
 //! every bad input raises `ValueError` with the library's message, the one
 //! the command line prints after `error: `. The GIL is released while
 //! sampling, and Ctrl-C stops a run (`KeyboardInterrupt`), as does the
@@ -10,6 +11,7 @@
 //! alone sees signals).
 use geosens::image::ImageResult;
 use geosens::job::{ImageReport, Job, RenderJob, SceneSource, Target};
+use geosens::optimize::{Optimizer, Product, Record, Sampling, Settings};
 use geosens::report::Report;
 use geosens::runner::Progress;
 use geosens::shard::{Merged, Shard, State, merge as merge_states};
@@ -108,6 +110,22 @@ fn interruptible<T: Send>(
     stop: Option<&Py<PyAny>>,
     work: impl FnOnce(Progress) -> Result<T, Error> + Send,
 ) -> PyResult<Result<T, Error>> {
+    interruptible_with(py, stop, |()| Ok(true), |progress, _| work(progress))
+}
+
+/// [`interruptible`] for a run that hands the calling thread messages as it
+/// goes (an optimisation's records): `work` gets, beside the progress hook,
+/// a function that passes a message to `receive`, called with the GIL on
+/// the calling thread, and returns what `receive` returned (true to go on)
+/// once it has: the run waits. A message is not received (false) once the
+/// run is being stopped; an exception raised by `receive` stops the run
+/// and is raised here, as a signal's.
+fn interruptible_with<T: Send, M: Send>(
+    py: Python<'_>,
+    stop: Option<&Py<PyAny>>,
+    mut receive: impl FnMut(M) -> PyResult<bool>,
+    work: impl FnOnce(Progress, &dyn Fn(M) -> bool) -> Result<T, Error> + Send,
+) -> PyResult<Result<T, Error>> {
     let stopping = AtomicBool::new(false);
     let hook = |_done: u64| {
         if stopping.load(Ordering::Relaxed) {
@@ -118,13 +136,17 @@ fn interruptible<T: Send>(
     };
     let hook = &hook;
     std::thread::scope(|s| {
-        let (tx, rx) = mpsc::channel();
+        // Messages (`None`: the run has ended), and the answers to them.
+        let (tx, rx) = mpsc::channel::<Option<M>>();
+        let (answer_tx, answer_rx) = mpsc::channel::<bool>();
         // The stack of a main thread: a run on one thread runs here.
         let worker = std::thread::Builder::new()
             .stack_size(8 << 20)
             .spawn_scoped(s, move || {
-                let out = work(hook);
-                let _ = tx.send(());
+                // No answer (the calling thread is gone): stop.
+                let send = |m: M| tx.send(Some(m)).is_ok() && answer_rx.recv().unwrap_or(false);
+                let out = work(hook, &send);
+                let _ = tx.send(None);
                 out
             })
             .map_err(|e| PyRuntimeError::new_err(format!("cannot start the run's thread: {e}")))?;
@@ -135,8 +157,18 @@ fn interruptible<T: Send>(
             let (waited, back) =
                 py.detach(move || (rx.recv_timeout(Duration::from_millis(50)), rx));
             rx = back;
-            if waited != Err(mpsc::RecvTimeoutError::Timeout) {
-                break;
+            match waited {
+                Ok(Some(m)) => {
+                    let go_on = signal.is_none()
+                        && receive(m).unwrap_or_else(|e| {
+                            signal = Some(e);
+                            stopping.store(true, Ordering::Relaxed);
+                            false
+                        });
+                    let _ = answer_tx.send(go_on);
+                }
+                Ok(None) | Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
             }
             if signal.is_none() {
                 signal = py.check_signals().err().or_else(|| stopped(py, stop));
@@ -291,6 +323,99 @@ fn render(
     out.and_then(|o| o.into_py(py)).map_err(value_error)
 }
 
+/// `geosens optimize --json` on a scene file (`path`) or JSON text (`json`),
+/// flatland or 3D by its points: the records' JSON lines. `each`, if given,
+/// is called with each record's line as it is made, on the calling thread;
+/// a false answer ends the run after that record (it is the last returned).
+/// Ctrl-C and `stop` end it after the iteration under way
+/// (`KeyboardInterrupt`, [`interruptible_with`]).
+#[pyfunction]
+#[pyo3(signature = (path, json, method, optimizer, iterations, paths_per_step, step, batches, fd_step, tolerance, seed, threads, each, stop))]
+#[allow(clippy::too_many_arguments)]
+fn optimize(
+    py: Python<'_>,
+    path: Option<PathBuf>,
+    json: Option<String>,
+    method: &str,
+    optimizer: &str,
+    iterations: u64,
+    paths_per_step: u64,
+    step: f64,
+    batches: u64,
+    fd_step: Option<f64>,
+    tolerance: f64,
+    seed: u64,
+    threads: usize,
+    each: Option<Py<PyAny>>,
+    stop: Option<Py<PyAny>>,
+) -> PyResult<Vec<String>> {
+    let config = |m: String| value_error(Error::Config(m));
+    let method = method.parse::<Method>().map_err(value_error)?;
+    let optimizer = match optimizer {
+        "adam" => Optimizer::Adam,
+        "sgd" => Optimizer::Sgd,
+        other => {
+            return Err(config(format!(
+                "unknown optimizer {other:?}: expected one of adam, sgd"
+            )));
+        }
+    };
+    // The command line's checks (clap's types and its own), named as
+    // Python names them.
+    if !(step.is_finite() && step > 0.0) {
+        return Err(config(format!("step {step} is not a positive number")));
+    }
+    let iterations = match u32::try_from(iterations) {
+        Ok(0) => return Err(config("iterations must be at least 1".into())),
+        Ok(n) => n,
+        Err(_) => return Err(config(format!("iterations {iterations} is over 2^32 - 1"))),
+    };
+    let batches = u32::try_from(batches)
+        .map_err(|_| config(format!("batches {batches} is over 2^32 - 1")))?;
+    let settings = Settings {
+        method,
+        optimizer,
+        iterations,
+        step,
+        sampling: Sampling {
+            paths: paths_per_step,
+            batches,
+            seed,
+            threads,
+            fd_step,
+            product: Product::Independent,
+        },
+        tolerance,
+    };
+    let source = source(path, json)?;
+    let receive = |line: String| -> PyResult<bool> {
+        match &each {
+            Some(f) => f.bind(py).call1((line,))?.is_truthy(),
+            None => Ok(true),
+        }
+    };
+    let out = interruptible_with(py, stop.as_ref(), receive, |_progress, send| {
+        let mut lines = Vec::new();
+        let mut failed = None;
+        let each = |r: &Record| match serde_json::to_string(r) {
+            Ok(line) => {
+                lines.push(line.clone());
+                send(line)
+            }
+            Err(e) => {
+                failed = Some(Error::Output(e.to_string()));
+                false
+            }
+        };
+        match source.dimension()? {
+            Some(3) => geosens::optimize::optimize(&source.mesh_study()?, &settings, each)?,
+            _ => geosens::optimize::optimize(&source.flat_study()?, &settings, each)?,
+        };
+        failed.map_or(Ok(lines), Err)
+    })?;
+    out.map_err(value_error)
+}
+
 /// `geosens merge`: `states` holds, per state, its name in messages and
 /// either its file or its JSON text.
 #[pyfunction]
@@ -325,6 +450,7 @@ fn _geosens(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add_function(wrap_pyfunction!(optimize, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

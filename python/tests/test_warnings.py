@@ -37,6 +37,9 @@ def test_caveats_are_runtime_warnings(cli, tmp_path):
     assert want and all("occluder_tx" in w or "occluder" in w for w in want)
     assert [str(w.message) for w in caught] == want
     assert all(w.category is RuntimeWarning for w in caught)
+    # Issued at the caller's line, not inside the package (flat's went to
+    # geosens/__init__.py, one frame short).
+    assert all(w.filename == __file__ for w in caught), [w.filename for w in caught]
     caveated = [k for k, v in py["sensitivity"].items() if "caveat" in v]
     assert caveated and not any(py["sensitivity"][k]["reliable"] for k in caveated)
 

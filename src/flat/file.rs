@@ -120,6 +120,12 @@ pub fn from_json(text: &str) -> Result<Scene, Error> {
     file.into_scene()
 }
 
+/// Parses and validates the optimisation problem in a JSON scene (what a
+/// Python dict becomes), as [`load_study`] a file's.
+pub fn study_from_json(text: &str) -> Result<Study<Scene>, Error> {
+    parse_json(text)?.into_study()
+}
+
 /// The TOML text of a scene; [`from_toml`] reads it back to the same shapes,
 /// parameters and sensor.
 pub fn to_toml(scene: &Scene) -> String {

@@ -228,6 +228,13 @@ pub fn from_json(text: &str) -> Result<Scene, Error> {
     parse_json(text)?.into_scene(Path::new(""))
 }
 
+/// Parses and validates the optimisation problem in a JSON scene (what a
+/// Python dict becomes), as [`load_study`] a file's; `mesh` paths are
+/// relative to the current directory.
+pub fn study_from_json(text: &str) -> Result<Study<Scene>, Error> {
+    parse_json(text)?.into_study(Path::new(""))
+}
+
 /// The TOML text of a scene, meshes inline; [`from_toml`] reads it back to
 /// the same scene.
 pub fn to_toml(scene: &Scene) -> Result<String, Error> {
