@@ -461,8 +461,10 @@ def optimize(
             carries the records made before as its ``records`` attribute.
 
     Returns:
-        The records: ``{"iteration", "parameters": {name: offset}, "loss":
-        {"mean", "stderr"}, "gradient": {name: {"mean", "stderr"}},
+        The records: ``{"iteration", "parameters": {name: offset},
+        "average": {name: offset}`` (the mean iterate over the last half of
+        the run so far, the answer to report), ``"loss": {"mean",
+        "stderr"}, "gradient": {name: {"mean", "stderr"}},
         "paths", "seconds", "sampling_seconds"}`` and ``"notes"`` (what a
         step did beyond the rule: clamped to bounds, shortened to keep the
         scene valid) when there are any.

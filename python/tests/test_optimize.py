@@ -19,7 +19,7 @@ import geosens
 TRUE_TX = 0.15
 #: Where the sensors are.
 POINTS = [-0.5, -0.1, 0.3, 0.7]
-KEYS = {"iteration", "parameters", "loss", "gradient", "paths", "seconds", "sampling_seconds"}
+KEYS = {"iteration", "parameters", "average", "loss", "gradient", "paths", "seconds", "sampling_seconds"}
 
 
 def irradiance(x0: float, tx: float) -> float:
