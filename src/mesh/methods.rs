@@ -99,6 +99,9 @@ impl Model for Scene {
         let (shapes, params) = pose(self.shapes(), params, &owner, offsets)?;
         Scene::new(shapes, params, self.sensor())
     }
+    fn offset_rate(&self, j: usize, offset: f64) -> f64 {
+        crate::scene::pose::Pose::offset_rate(&self.parameters()[j].motion, offset)
+    }
     fn bounds(&self, j: usize) -> Option<[f64; 2]> {
         self.parameters()[j].bounds
     }

@@ -75,6 +75,9 @@ pub trait Model: Sized + Send + Sync + 'static {
     /// The scene at `offsets` from this pose, one per parameter
     /// ([`crate::scene::pose`]), validated again.
     fn posed(&self, offsets: &[f64]) -> Result<Self, Error>;
+    /// `∂δ_j/∂θ_j` at offset `θ_j` ([`crate::scene::pose::Pose::offset_rate`]):
+    /// the factor from this scene's `∂I/∂π_j` to the offset's.
+    fn offset_rate(&self, j: usize, offset: f64) -> f64;
     /// Parameter `j`'s bounds, if any (offsets from this pose).
     fn bounds(&self, j: usize) -> Option<[f64; 2]>;
     /// The pixel count of a camera sensor (1 for a probe).

@@ -114,7 +114,8 @@ pub struct Stepper {
 const BETA1: f64 = 0.9;
 const BETA2: f64 = 0.999;
 const EPSILON: f64 = 1e-12;
-/// Iterations over which the step halves (Adam) or falls by 2^0.75 (SGD).
+/// Iterations over which the step halves (Adam: `1/(1 + t/τ)`) or falls by
+/// 2^0.75 (gradient descent).
 const TAU: f64 = 50.0;
 
 impl Stepper {
@@ -180,7 +181,7 @@ pub fn optimize<S: Model>(
             seed: crate::rng::derive_seed(settings.sampling.seed, &[u64::from(iteration)]),
             ..settings.sampling
         };
-        let e = study.evaluate_posed(&posed, settings.method, &sampling)?;
+        let e = study.evaluate_posed(&posed, &theta, settings.method, &sampling)?;
         let g: Vec<f64> = e.gradient.iter().map(|v| v.mean).collect();
         let mut record = Record {
             iteration,

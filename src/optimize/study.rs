@@ -165,23 +165,23 @@ impl<S: Model> Study<S> {
         let start = Instant::now();
         let posed = self.posed(offsets)?;
         let posing = start.elapsed().as_secs_f64();
-        let mut e = self.evaluate_posed(&posed, method, sampling)?;
+        let mut e = self.evaluate_posed(&posed, offsets, method, sampling)?;
         e.setup_seconds += posing;
         Ok(e)
     }
 
-    /// [`Study::evaluate`] on a scene already posed.
+    /// [`Study::evaluate`] on the scene already posed at `offsets`.
     pub fn evaluate_posed(
         &self,
         posed: &S,
+        offsets: &[f64],
         method: Method,
         sampling: &Sampling,
     ) -> Result<Evaluation, Error> {
         let b = sampling.batches as usize;
-        if b < 2 {
+        if b < 3 {
             return config(format!(
-                "{} batches: the unbiased products need at least 2",
-                b
+                "{b} batches: the unbiased products need 2 and their jackknife error 3"
             ));
         }
         let names = self.parameter_names();
@@ -240,7 +240,14 @@ impl<S: Model> Study<S> {
                 }
             }
         }
-        let (loss, gradient) = terms.finish(sampling.product);
+        let (loss, mut gradient) = terms.finish(sampling.product);
+        // The estimators differentiate the posed scene's own motions; the
+        // chain rule to the offsets (a scale's: 1/(1 + θ)).
+        for (j, g) in gradient.iter_mut().enumerate() {
+            let rate = posed.offset_rate(j, offsets[j]);
+            g.mean *= rate;
+            g.stderr *= rate;
+        }
         Ok(Evaluation {
             loss,
             gradient,

@@ -8,7 +8,9 @@
 //! velocity is then its axis, as the estimators assume; the rotation's (or
 //! scale's) velocity at the posed point is the rotation's about `p + t`, so
 //! the posed scene's parameters carry their pivot along with the
-//! translation. Two rotations of one shape would not compose this way
+//! translation. A scale's velocity is relative to the posed size, so its
+//! derivative takes the chain rule's factor `1/(1 + θ)`
+//! ([`Pose::offset_rate`]). Two rotations of one shape would not compose this way
 //! (their derivatives would be pushed through each other), and are refused.
 use super::config;
 use super::parameter::Parameter;
@@ -30,6 +32,16 @@ pub trait Pose: Copy {
     }
     /// The same motion with its pivot (if any) moved by `d`.
     fn pivot_moved(&self, d: Self::V) -> Self;
+    /// `∂δ/∂θ`: how the motion's own parameter `δ` at the posed scene
+    /// moves with the offset `θ`. 1 for a translation and a rotation
+    /// (`R(θ + δ) = R(δ) R(θ)` about one pivot and axis); `1 + θ` for a
+    /// scale, whose posed size is `(1 + θ)` times the file's, so that
+    /// `(1 + δ)(1 + θ) = 1 + θ + δ (1 + θ)`: the estimators' `∂I/∂δ` is
+    /// `(1 + θ) ∂I/∂θ`.
+    fn offset_rate(&self, offset: f64) -> f64 {
+        let _ = offset;
+        1.0
+    }
 }
 
 /// What posing needs of a shape.

@@ -140,18 +140,31 @@ fn run<S: Model>(
     if let Some(e) = failed {
         return Err(e.into());
     }
-    if stop.load(Ordering::SeqCst)
-        && let Some(last) = records.last()
-    {
-        eprintln!(
-            "stopped by Ctrl-C after iteration {}: {}",
-            last.iteration,
-            last.parameters
-                .iter()
-                .map(|(k, v)| format!("{k} = {v:.6}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+    let listed = |values: &std::collections::BTreeMap<String, f64>| {
+        values
+            .iter()
+            .map(|(k, v)| format!("{k} = {v:.6}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if let Some(last) = records.last() {
+        if stop.load(Ordering::SeqCst) {
+            eprintln!(
+                "stopped by Ctrl-C after iteration {}: {} (tail average {})",
+                last.iteration,
+                listed(&last.parameters),
+                listed(&last.average)
+            );
+        }
+        if !args.json {
+            writeln!(
+                out,
+                "mean of iterates {}..{}: {}",
+                last.iteration.div_ceil(2),
+                last.iteration,
+                listed(&last.average)
+            )?;
+        }
     }
     Ok(())
 }

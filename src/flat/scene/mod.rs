@@ -101,6 +101,12 @@ impl crate::scene::pose::Pose for Motion {
             _ => None,
         }
     }
+    fn offset_rate(&self, offset: f64) -> f64 {
+        match self {
+            Motion::Scale { .. } => 1.0 / (1.0 + offset),
+            _ => 1.0,
+        }
+    }
     fn pivot_moved(&self, d: DVec2) -> Motion {
         match *self {
             Motion::Rotate { pivot } => Motion::Rotate {

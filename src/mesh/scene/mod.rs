@@ -144,6 +144,12 @@ impl crate::scene::pose::Pose for Motion {
             _ => None,
         }
     }
+    fn offset_rate(&self, offset: f64) -> f64 {
+        match self {
+            Motion::Scale { .. } => 1.0 / (1.0 + offset),
+            _ => 1.0,
+        }
+    }
     fn pivot_moved(&self, d: DVec3) -> Motion {
         match *self {
             Motion::Rotate { axis, pivot } => Motion::Rotate {
