@@ -12,6 +12,7 @@
 //! scene invalid until it is valid, saying so in the record. Every
 //! iteration's randomness derives from the seed and the iteration, so a run
 //! is reproducible bit for bit whatever the thread count.
+pub mod scan;
 pub mod study;
 
 pub use study::{Evaluation, Product, Sampling, Study, Value};
@@ -166,6 +167,13 @@ pub fn optimize<S: Model>(
     settings: &Settings,
     mut each: impl FnMut(&Record) -> bool,
 ) -> Result<Vec<Record>, Error> {
+    if settings.method == Method::Intensity {
+        return Err(Error::Config(
+            "the intensity method estimates no gradient: optimise with expectation, \
+             rendering, transport or fd"
+                .into(),
+        ));
+    }
     let names = study.parameter_names();
     let bounds = study.bounds();
     let mut theta = vec![0.0; names.len()];
