@@ -59,6 +59,8 @@ pub fn scene_file(name: &str) -> Option<&'static str> {
         "radiance" => include_str!("../../../scenes/radiance.toml"),
         "submerged" => include_str!("../../../scenes/submerged.toml"),
         "camera_line" => include_str!("../../../scenes/camera_line.toml"),
+        "inverse_occluder" => include_str!("../../../scenes/inverse_occluder.toml"),
+        "design_reflector" => include_str!("../../../scenes/design_reflector.toml"),
         _ => return None,
     })
 }

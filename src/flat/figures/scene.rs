@@ -31,8 +31,10 @@ use serde::Serialize;
 use std::path::PathBuf;
 
 /// The scenes drawn, one panel each.
-pub const SCENES: [&str; 9] = [
+pub const SCENES: [&str; 11] = [
     "occluder",
+    "inverse_occluder",
+    "design_reflector",
     "polygon_occluder",
     "absorbing_slab",
     "fog",
@@ -49,7 +51,14 @@ pub const SCENES: [&str; 9] = [
 pub const FIGURES: [(&str, &[&str]); 2] = [
     (
         "flat_scene_opaque",
-        &["occluder", "polygon_occluder", "reflector", "camera_line"],
+        &[
+            "occluder",
+            "polygon_occluder",
+            "reflector",
+            "camera_line",
+            "inverse_occluder",
+            "design_reflector",
+        ],
     ),
     (
         "flat_scene_media",
@@ -70,6 +79,8 @@ fn what(name: &str) -> &'static str {
         "polygon_occluder" => "a non-convex Γ",
         "reflector" => "light after a bounce",
         "camera_line" => "a line camera",
+        "inverse_occluder" => "fit to eight readings",
+        "design_reflector" => "aim at a hidden receiver",
         "absorbing_slab" => "absorption only",
         "fog" => "a scattering polygon",
         "radiance" => "one line of sight",
