@@ -26,6 +26,7 @@ pub mod exact;
 #[cfg(feature = "figures")]
 pub mod figures;
 pub mod file;
+pub mod inverse;
 pub mod knots;
 pub mod lobe;
 pub mod methods;
