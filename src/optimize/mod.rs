@@ -12,6 +12,7 @@
 //! scene invalid until it is valid, saying so in the record. Every
 //! iteration's randomness derives from the seed and the iteration, so a run
 //! is reproducible bit for bit whatever the thread count.
+pub mod compare;
 pub mod scan;
 pub mod study;
 

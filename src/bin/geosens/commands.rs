@@ -243,6 +243,7 @@ pub(super) fn compare_command(
         writeln!(out, "{:<12} {seconds:>9.3} {z:>7.1} {bad:>11}", m.name())?;
     }
     mesh_table(&cfg, out)?;
+    optimisation_table(&cfg, out)?;
     writeln!(
         out,
         "total wall time {:.2} s",
@@ -278,6 +279,73 @@ pub(super) fn compare_command(
             args.figures.display()
         );
     }
+    Ok(())
+}
+
+/// Seeds of the quick optimisation table.
+const OPTIMISATION_SEEDS: u64 = 3;
+
+/// The budget of the quick optimisation table's runs: the example's
+/// iterations, an eighth of its paths.
+const OPTIMISATION_BUDGET: geosens::optimize::compare::Budget =
+    geosens::optimize::compare::Budget {
+        iterations: 400,
+        paths: 1024,
+    };
+
+/// The short version of `examples/optimize_compare.rs`: every method
+/// optimising the flatland inverse problem (scenes/inverse_occluder.toml)
+/// from a few seeds with a small budget, the median wall time until the
+/// tail average's error falls under the tolerance for good, and the final
+/// error.
+fn optimisation_table(
+    cfg: &RunConfig,
+    out: &mut impl Write,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use geosens::optimize::compare::{self, Loaded, TOLERANCE, Variant};
+    let loaded = Loaded::flat_toml(compare::INVERSE_OCCLUDER)?;
+    let truth = compare::PROBLEMS[0].truth.unwrap_or(&[0.12, 0.2]);
+    let budget = OPTIMISATION_BUDGET;
+    writeln!(
+        out,
+        "\noptimisation: the flatland inverse problem (inverse_occluder.toml), Adam, \
+         {} iterations of {} paths per measurement, seeds {} to {}; time to tolerance: \
+         until the tail average's error (translation / size, rotation in rad) falls under \
+         {TOLERANCE:e} and stays there (examples/optimize_compare for the full table)",
+        budget.iterations,
+        budget.paths,
+        cfg.seed,
+        cfg.seed + OPTIMISATION_SEEDS - 1
+    )?;
+    let mut rows = Vec::new();
+    for method in [
+        Method::Expectation,
+        Method::Rendering,
+        Method::Transport,
+        Method::Fd,
+    ] {
+        let bar = progress_bar(
+            u64::from(budget.iterations + 1) * OPTIMISATION_SEEDS,
+            "iterations",
+            format!("optimise {}", method.name()),
+        );
+        let runs = (0..OPTIMISATION_SEEDS)
+            .map(|k| {
+                compare::run_one(
+                    &loaded,
+                    truth,
+                    Variant::of(method),
+                    cfg.seed + k,
+                    budget,
+                    cfg.threads,
+                    || bar.inc(1),
+                )
+            })
+            .collect::<Result<Vec<_>, _>>();
+        bar.finish_and_clear();
+        rows.push(compare::row("inverse_occluder", &runs?));
+    }
+    writeln!(out, "{}", compare::text_table(&rows))?;
     Ok(())
 }
 
