@@ -63,7 +63,7 @@ fn main() -> Result<(), Error> {
         };
         let answer = match p.truth {
             Some(t) => t.to_vec(),
-            None => compare::scan(&loaded, 16 * budget.paths)?,
+            None => compare::scan(&loaded, 4 * budget.paths)?,
         };
         plans.push((p.file.to_owned(), loaded, answer, budget, variants(), seeds));
     }
