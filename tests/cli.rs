@@ -338,6 +338,15 @@ fn compare_runs() {
         assert_eq!(t[3].parse::<usize>().ok(), Some(bad), "{line}");
     }
     assert_mesh_tables(&mut lines, &cfg);
+    // The short comparison by time to the answer: a row per method.
+    assert!(lines.next().unwrap().starts_with("optimisation: "));
+    assert!(lines.next().unwrap().starts_with("problem"));
+    for m in ["expectation", "rendering", "transport", "fd"] {
+        let line = lines.next().unwrap();
+        let t: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(t[..2], ["inverse_occluder", m], "{line}");
+        assert!(line.contains("/3"), "{line}");
+    }
     assert!(lines.next().unwrap().starts_with("total wall time"));
     assert_eq!(lines.next(), None);
     assert_rejected(&["compare", "--paths", "1"], 1, &["paths = 1"]);

@@ -333,7 +333,9 @@ fn estimated_peak<S: Model>(
         product: Product::Independent,
     };
     let axis = |lo: f64, hi: f64| -> Vec<f64> {
-        (0..21).map(|i| lo + (hi - lo) * f64::from(i) / 20.0).collect()
+        (0..21)
+            .map(|i| lo + (hi - lo) * f64::from(i) / 20.0)
+            .collect()
     };
     let lowest = |points: &[super::scan::ScanPoint]| {
         points
@@ -365,7 +367,11 @@ fn estimated_peak<S: Model>(
         .collect();
     let peak = fit_quadratic(&points)?.stationary();
     match peak {
-        Some(p) if p.iter().enumerate().all(|(d, x)| (bounds[d][0]..=bounds[d][1]).contains(x)) => {
+        Some(p)
+            if p.iter()
+                .enumerate()
+                .all(|(d, x)| (bounds[d][0]..=bounds[d][1]).contains(x)) =>
+        {
             Ok(p.to_vec())
         }
         _ => lowest(&fine),
