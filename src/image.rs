@@ -16,6 +16,7 @@ use crate::estimator::{Estimator, Quantity};
 use crate::rng;
 use crate::runner::{Progress, Stop};
 use crate::stats::{Estimate, Moments, StratumSums};
+#[cfg(feature = "parallel")]
 use rayon::prelude::*;
 
 /// Most paths per pixel.
@@ -214,11 +215,11 @@ pub fn render_pixels(
         out
     };
     let (pieces, seconds) = crate::runner::timed_on(threads, || -> Vec<Vec<Vec<PixelSums>>> {
-        if threads == 1 {
-            pieces.map(run).collect()
-        } else {
-            pieces.into_par_iter().map(run).collect()
+        #[cfg(feature = "parallel")]
+        if threads != 1 {
+            return pieces.into_par_iter().map(run).collect();
         }
+        pieces.map(run).collect()
     })?;
     stop.into_result()?;
     Ok((pieces.into_iter().flatten().collect(), seconds))

@@ -39,7 +39,6 @@ use crate::stats::Estimate;
 use crate::{flat, mesh};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::Instant;
 
 /// Parses a method's name, or `exact` (the rod's exact solution, `None`)
 /// where `exact` is allowed; the error lists the names accepted.
@@ -364,9 +363,9 @@ pub fn exact_result(header: &Header) -> Result<RunResult, Error> {
         return Err(Error::Config("the exact solution is the rod's only".into()));
     };
     let (rod, probe) = given.build()?;
-    let start = Instant::now();
+    let start = crate::runner::Stopwatch::start();
     let values = rod_exact(&rod, &probe);
-    let seconds = start.elapsed().as_secs_f64();
+    let seconds = start.seconds();
     Ok(RunResult {
         method: "exact",
         estimates: rod_quantities()

@@ -20,10 +20,10 @@ use crate::error::Error;
 use crate::estimator::{Estimator, Quantity};
 use crate::rng;
 use crate::stats::{ChunkSums, Estimate, Moments};
+#[cfg(feature = "parallel")]
 use rayon::prelude::*;
 use serde::Serialize;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
 /// Paths per chunk. Part of what a seed means: changing it changes results.
 pub const CHUNK: u64 = 4096;
@@ -222,10 +222,18 @@ fn run_blocks<E: Estimator + ?Sized>(
     while first < blocks.end {
         let last = blocks.end.min(first + per_batch);
         let range = first * BLOCK..chunks.min(last * BLOCK);
+        #[cfg(feature = "parallel")]
         let per_chunk: Vec<Vec<Moments>> = if serial {
             range.map(chunk).collect()
         } else {
             range.into_par_iter().map(chunk).collect()
+        };
+        // No threads (the feature `parallel` off): the same chunks in the
+        // same order, so the same bits.
+        #[cfg(not(feature = "parallel"))]
+        let per_chunk: Vec<Vec<Moments>> = {
+            let _ = serial;
+            range.map(chunk).collect()
         };
         if stop.stopping() {
             break;
@@ -282,23 +290,53 @@ fn merge_into(total: &mut [Moments], block: &[Moments]) {
 /// global pool (all cores, built once per process) serves any parallel
 /// iterator inside (a caller that wants one thread iterates serially
 /// itself: no pool to build, a thread spawn per call saved); any other
-/// count builds a pool of its own, whose start is not timed.
+/// count builds a pool of its own, whose start is not timed. Without the
+/// feature `parallel` every count runs on the calling thread.
 pub(crate) fn timed_on<T: Send>(
     threads: usize,
     work: impl FnOnce() -> T + Send,
 ) -> Result<(T, f64), Error> {
-    if threads <= 1 {
-        let start = Instant::now();
-        let out = work();
-        return Ok((out, start.elapsed().as_secs_f64()));
+    #[cfg(feature = "parallel")]
+    if threads > 1 {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| Error::Config(format!("cannot start {threads} threads: {e}")))?;
+        let start = Stopwatch::start();
+        let out = pool.install(work);
+        return Ok((out, start.seconds()));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::Config(format!("cannot start {threads} threads: {e}")))?;
-    let start = Instant::now();
-    let out = pool.install(work);
-    Ok((out, start.elapsed().as_secs_f64()))
+    #[cfg(not(feature = "parallel"))]
+    let _ = threads;
+    let start = Stopwatch::start();
+    let out = work();
+    Ok((out, start.seconds()))
+}
+
+/// Wall time since it started. WebAssembly in a browser has no clock in
+/// `std` (`Instant::now` panics there): it reads 0 s, and the page times
+/// the run itself.
+pub(crate) struct Stopwatch {
+    #[cfg(not(target_arch = "wasm32"))]
+    start: std::time::Instant,
+}
+
+impl Stopwatch {
+    /// A stopwatch started now.
+    pub(crate) fn start() -> Stopwatch {
+        Stopwatch {
+            #[cfg(not(target_arch = "wasm32"))]
+            start: std::time::Instant::now(),
+        }
+    }
+
+    /// Seconds since [`Stopwatch::start`] (0 on wasm32).
+    pub(crate) fn seconds(&self) -> f64 {
+        #[cfg(not(target_arch = "wasm32"))]
+        return self.start.elapsed().as_secs_f64();
+        #[cfg(target_arch = "wasm32")]
+        0.0
+    }
 }
 
 /// Samples `cfg.paths` paths of `est` and returns its estimates.

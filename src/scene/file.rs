@@ -106,7 +106,9 @@ pub(crate) enum Unread {
     /// It holds more than the cap, in bytes.
     TooLarge(u64),
     /// It is a named pipe or a socket: opening or reading it waits for a
-    /// writer that may never come or never close it, silently.
+    /// writer that may never come or never close it, silently. (Unix
+    /// only: elsewhere, wasm32 say, no file is one.)
+    #[cfg_attr(not(unix), allow(dead_code))]
     Pipe,
     /// Its first byte past white space is not the one its format starts
     /// with (a stream of zeros, say: refused before the cap is read).
