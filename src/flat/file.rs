@@ -29,55 +29,35 @@
 //! Unknown fields are errors, and so is everything [`Scene::new`] rejects.
 //! Every error is an [`Error::Scene`] that names the file (for [`load`]), and
 //! for a parse error the line, the column and the field at fault.
-use super::scene::{Parameter, Scene, Sensor, Shape};
+use super::scene::{Scene, Sensor, Shape};
 use crate::error::Error;
 use crate::optimize::Study;
-use crate::scene::file::{first_sensor, in_file, json_error, objective_of, parse_file};
-use crate::scene::objective::{Measurement, Objective};
-use serde::{Deserialize, Serialize};
+use crate::scene::file::{Contents, in_file, json_error, parse_file};
 use std::path::Path;
 
-/// The contents of a scene file: [`Scene::new`]'s arguments.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SceneFile {
-    /// The shapes, in order.
-    pub shapes: Vec<Shape>,
-    /// The parameters whose sensitivities are wanted (none if absent).
-    #[serde(default)]
-    pub parameters: Vec<Parameter>,
-    /// What is measured (the first measurement's sensor if absent).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sensor: Option<Sensor>,
-    /// For an optimisation: what is measured, with targets and weights.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub measurements: Vec<Measurement<Sensor>>,
-    /// For an optimisation: what is made least or greatest.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub objective: Option<Objective>,
-}
+/// The contents of a flatland scene file: [`Scene::new`]'s arguments, and
+/// an optimisation's measurements and objective.
+pub type SceneFile = Contents<Shape, super::scene::Motion, Sensor>;
 
 impl SceneFile {
     /// The file form of a scene (pivots resolved, sensor vectors normalised).
     pub fn of(scene: &Scene) -> SceneFile {
-        SceneFile {
-            shapes: scene.shapes().to_vec(),
-            parameters: scene.parameters().to_vec(),
-            sensor: Some(scene.sensor()),
-            measurements: Vec::new(),
-            objective: None,
-        }
+        Contents::of_parts(
+            scene.shapes().to_vec(),
+            scene.parameters().to_vec(),
+            scene.sensor(),
+        )
     }
 
     /// Validates the contents into a scene.
     pub fn into_scene(self) -> Result<Scene, Error> {
-        let sensor = first_sensor(self.sensor, &self.measurements)?;
+        let sensor = self.scene_sensor()?;
         Scene::new(self.shapes, self.parameters, sensor)
     }
 
     /// Validates the contents into an optimisation problem.
     pub fn into_study(self) -> Result<Study<Scene>, Error> {
-        let (measurements, kind) = (self.measurements.clone(), objective_of(&self.objective)?);
+        let (measurements, kind) = self.optimisation()?;
         Study::new(self.into_scene()?, measurements, kind)
     }
 }

@@ -44,13 +44,12 @@
 //! for a parse error the line and the field at fault, for an OBJ the shape
 //! and the OBJ's path. [`from_toml`] and [`from_json`] read `mesh` paths
 //! relative to the current directory.
-use super::scene::{Medium, Parameter, Scene, Sensor, Shape, Surface};
+use super::scene::{Medium, Scene, Sensor, Shape, Surface};
 use crate::error::Error;
 use crate::optimize::Study;
 use crate::scene::file::{
-    MAX_SCENE_BYTES, first_sensor, in_file, json_error, objective_of, parse_file, read_bytes_capped,
+    Contents, MAX_SCENE_BYTES, in_file, json_error, parse_file, read_bytes_capped,
 };
-use crate::scene::objective::{Measurement, Objective};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -120,34 +119,17 @@ impl ShapeFile {
     }
 }
 
-/// The contents of a scene file: [`Scene::new`]'s arguments, meshes inline
-/// or by OBJ.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MeshFile {
-    /// The shapes, in order.
-    pub shapes: Vec<ShapeFile>,
-    /// The parameters whose sensitivities are wanted (none if absent).
-    #[serde(default)]
-    pub parameters: Vec<Parameter>,
-    /// What is measured.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sensor: Option<Sensor>,
-    /// For an optimisation: what is measured, with targets and weights.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub measurements: Vec<Measurement<Sensor>>,
-    /// For an optimisation: what is made least or greatest.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub objective: Option<Objective>,
-}
+/// The contents of a 3D scene file: [`Scene::new`]'s arguments, meshes
+/// inline or by OBJ, and an optimisation's measurements and objective.
+pub type MeshFile = Contents<ShapeFile, super::scene::Motion, Sensor>;
 
 impl MeshFile {
     /// The file form of a scene, meshes inline (welded and oriented, pivots
     /// resolved, sensor vectors normalised): [`MeshFile::into_scene`] gives
     /// back the same scene.
     pub fn of(scene: &Scene) -> MeshFile {
-        MeshFile {
-            shapes: scene
+        Contents::of_parts(
+            scene
                 .shapes()
                 .iter()
                 .map(|s| ShapeFile {
@@ -159,29 +141,27 @@ impl MeshFile {
                     medium: s.medium,
                 })
                 .collect(),
-            parameters: scene.parameters().to_vec(),
-            sensor: Some(scene.sensor()),
-            measurements: Vec::new(),
-            objective: None,
-        }
+            scene.parameters().to_vec(),
+            scene.sensor(),
+        )
     }
 
     /// Reads the OBJ files (relative to the directory `base`) and validates
     /// the contents into a scene.
     pub fn into_scene(self, base: &Path) -> Result<Scene, Error> {
+        let sensor = self.scene_sensor()?;
         let shapes = self
             .shapes
             .into_iter()
             .map(|s| s.into_shape(base))
             .collect::<Result<Vec<_>, _>>()?;
-        let sensor = first_sensor(self.sensor, &self.measurements)?;
         Scene::new(shapes, self.parameters, sensor)
     }
 
     /// Reads the OBJ files (relative to `base`) and validates the contents
     /// into an optimisation problem.
     pub fn into_study(self, base: &Path) -> Result<Study<Scene>, Error> {
-        let (measurements, kind) = (self.measurements.clone(), objective_of(&self.objective)?);
+        let (measurements, kind) = self.optimisation()?;
         Study::new(self.into_scene(base)?, measurements, kind)
     }
 }

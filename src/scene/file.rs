@@ -244,7 +244,7 @@ fn key_before(text: &str, line: usize, column: usize) -> Option<String> {
 }
 
 /// The scene's sensor: the file's `[sensor]`, else its first measurement's.
-pub(crate) fn first_sensor<S: Copy>(
+fn first_sensor<S: Copy>(
     sensor: Option<S>,
     measurements: &[crate::scene::objective::Measurement<S>],
 ) -> Result<S, Error> {
@@ -259,7 +259,7 @@ pub(crate) fn first_sensor<S: Copy>(
 
 /// The file's objective: refused when absent (the caller asked for an
 /// optimisation).
-pub(crate) fn objective_of(
+fn objective_of(
     objective: &Option<crate::scene::objective::Objective>,
 ) -> Result<crate::scene::objective::ObjectiveKind, Error> {
     objective.map(|o| o.kind).ok_or_else(|| {
@@ -269,6 +269,76 @@ pub(crate) fn objective_of(
                 .into(),
         )
     })
+}
+
+/// The contents of a scene file, whatever its dimension (`Sh` its shapes'
+/// file form, `M` its motions, `Se` its sensors): flatland's
+/// [`SceneFile`](crate::flat::file::SceneFile) and 3D's
+/// [`MeshFile`](crate::mesh::file::MeshFile).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(
+    deny_unknown_fields,
+    bound(
+        serialize = "Sh: serde::Serialize, M: serde::Serialize, Se: serde::Serialize",
+        deserialize = "Sh: serde::Deserialize<'de>, M: serde::Deserialize<'de>, \
+                       Se: serde::de::DeserializeOwned"
+    )
+)]
+pub struct Contents<Sh, M, Se> {
+    /// The shapes, in order.
+    pub shapes: Vec<Sh>,
+    /// The parameters whose sensitivities are wanted (none if absent).
+    #[serde(default)]
+    pub parameters: Vec<crate::scene::parameter::Parameter<M>>,
+    /// What is measured (the first measurement's sensor if absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<Se>,
+    /// For an optimisation: what is measured, with targets and weights.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub measurements: Vec<crate::scene::objective::Measurement<Se>>,
+    /// For an optimisation: what is made least or greatest.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub objective: Option<crate::scene::objective::Objective>,
+}
+
+impl<Sh, M, Se: Copy> Contents<Sh, M, Se> {
+    /// A scene's file form: its shapes, parameters and sensor.
+    pub fn of_parts(
+        shapes: Vec<Sh>,
+        parameters: Vec<crate::scene::parameter::Parameter<M>>,
+        sensor: Se,
+    ) -> Self {
+        Contents {
+            shapes,
+            parameters,
+            sensor: Some(sensor),
+            measurements: Vec::new(),
+            objective: None,
+        }
+    }
+
+    /// The scene's sensor: the file's `[sensor]`, else its first
+    /// measurement's.
+    pub fn scene_sensor(&self) -> Result<Se, Error> {
+        first_sensor(self.sensor, &self.measurements)
+    }
+
+    /// The optimisation's measurements and objective (refused without an
+    /// `[objective]`).
+    pub fn optimisation(
+        &self,
+    ) -> Result<
+        (
+            Vec<crate::scene::objective::Measurement<Se>>,
+            crate::scene::objective::ObjectiveKind,
+        ),
+        Error,
+    >
+    where
+        Se: Clone,
+    {
+        Ok((self.measurements.clone(), objective_of(&self.objective)?))
+    }
 }
 
 #[cfg(test)]
