@@ -1,7 +1,7 @@
 //! Scene files: a flatland [`Scene`] written as TOML or JSON.
 //!
 //! A file holds the shapes, the parameters (optional) and the sensor, spelt
-//! as the serde forms of [`Shape`], [`Parameter`] and [`Sensor`]
+//! as the serde forms of [`Shape`], [`Parameter`](super::scene::Parameter) and [`Sensor`]
 //! (points are `[x, y]`). In TOML:
 //!
 //! ```toml
