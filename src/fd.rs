@@ -276,7 +276,7 @@ impl Estimator for CentralDifference {
 /// light-selection weight, 10⁵ sizes from the origin) sit at random about
 /// one another and once made 81 000 "jumps" of a run whose real jumps were
 /// never drawn: its estimate, the smooth part alone, was marked reliable
-/// (campaign, `tests/flat_failures.rs`).
+/// (seen in random scenes, `tests/flat_failures.rs`).
 #[inline]
 pub fn jumped(nominal: f64, plus: f64, minus: f64) -> bool {
     let d = (plus - minus).abs();

@@ -285,7 +285,7 @@ impl Moments {
     /// (weights below ~10⁻¹⁵⁴: a rod 380 mean free paths long, a lamp of
     /// radiance 10⁻¹⁷⁰), so that `m2` is 0 or subnormal: the error bar would
     /// read 0 ± 0 (or a few ulps of the smallest double) and the estimate
-    /// "reliable" whatever its error (campaign: 1.43e-184 ± 0 against the
+    /// "reliable" whatever its error (seen in random scenes: 1.43e-184 ± 0 against the
     /// exact 1.33e-184; −5.7e-168 ± 0 against +2.8e-193). The weights vary
     /// for sure when zeros sit beside non-zero weights, or when their
     /// absolute values do not all equal the largest (`Σ|w|` against

@@ -185,7 +185,7 @@ impl Boundaries for Plane {
     /// rounding of its coordinates: a reflecting sliver (θ ~ 10⁻⁴) 10⁵
     /// from the origin had its nested paths start across the other face,
     /// and rendering and transport read half the derivative, "reliable"
-    /// (campaign).
+    /// (seen in random scenes).
     #[inline]
     fn off_boundary(&self, b: &BoundaryPoint<DVec2>, p: u32) -> DVec2 {
         let segments = self.scene.segments();

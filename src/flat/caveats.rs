@@ -23,7 +23,7 @@ pub use crate::path::tolerance::TIE;
 /// ends aligned). A corner of the moved shape then crosses the other's
 /// sight line at the nominal parameter, and the one-sided derivatives
 /// differ: each method returns one of them or neither, with an error bar
-/// that cannot tell (found by a random-scene campaign: rendering 1.009,
+/// that cannot tell (seen in random scenes: rendering 1.009,
 /// expectation 0, the two sides of the tie). One caveat per parameter of
 /// such a shape. The 3D twin is [`crate::mesh::methods::kinks`].
 pub fn ties(scene: &Scene) -> Vec<(Quantity, String)> {
@@ -35,7 +35,7 @@ pub fn ties(scene: &Scene) -> Vec<(Quantity, String)> {
     // `q − point`: ~64 ulps of the coordinates over the distance (at 10⁸,
     // 2 850 away: 5·10⁻¹⁰ rad). An edge-on lamp 4·10⁻¹² rad wide there was
     // no tie by TIE alone, and expectation read −0.0015 against 0.0433,
-    // "reliable" (campaign).
+    // "reliable" (seen in random scenes).
     let reach = corners
         .iter()
         .map(|c| c.0.abs().max_element())

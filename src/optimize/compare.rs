@@ -1,5 +1,5 @@
 //! The methods compared by what an optimisation costs to reach the answer
-//! (issue 32 point 6): every worked problem of [`PROBLEMS`], run by every
+//! (the book's chapter "Sensitivities at work"): every worked problem of [`PROBLEMS`], run by every
 //! method of [`variants`] from several seeds; per run, the wall time and
 //! the paths until the tail average's parameter error falls under
 //! [`TOLERANCE`] *and stays there for the rest of the run*, and the final

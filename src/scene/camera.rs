@@ -24,7 +24,7 @@ pub fn view_problem(fov_deg: f64, what: &str, sides: &[(&str, u32)]) -> Option<S
         return Some(why);
     }
     // A pixel's directions are the view axis plus a tangent offset: below
-    // ~10⁻¹⁵ they all round to the axis (a campaign's fov of 10⁻¹⁶°
+    // ~10⁻¹⁵ they all round to the axis (a random scene's fov of 10⁻¹⁶°
     // read I 37σ low and cube_x 0.85 where −6·10¹⁶ was due, both
     // "reliable"; 10⁻¹³° was already 30 % off).
     let pixel = 2.0 * (0.5 * fov_deg.to_radians()).tan() / f64::from(sides.first()?.1);

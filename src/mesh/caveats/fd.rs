@@ -12,8 +12,8 @@ use crate::method::model::Step;
 /// Why the central difference along parameter `j` (half step `h`) may not
 /// estimate the derivative: as seen from the sensor, the half step turns a
 /// vertex of the moved mesh by a quarter of an emitter's extent or more, so
-/// one step may carry a shadow edge across most of the lamp (found by a
-/// random-scene campaign: a lamp 10⁻³ wide, the default step, fd 125.000
+/// one step may carry a shadow edge across most of the lamp (seen in a
+/// random scene: a lamp 10⁻³ wide, the default step, fd 125.000
 /// ± 7·10⁻⁹ marked reliable against the exact 500: the quotient had
 /// saturated at the lamp's whole light over the step).
 pub(crate) fn outruns_lamp(scene: &Scene, j: usize, h: f64) -> Option<String> {
@@ -79,7 +79,7 @@ pub(crate) fn passes_sensor(scene: &Scene, j: usize, h: f64) -> Option<String> {
 /// one displaced scene and turns its back on it in the other, so within
 /// the step it is seen edge-on and the silhouette changes (a kink of `I`
 /// inside the step: the quotient is neither one-sided derivative, with an
-/// error bar that cannot see it). Found by a random-scene campaign: a
+/// error bar that cannot see it). Seen in a random scene: a
 /// tetrahedron whose face turned edge-on 10⁻⁴ rad from the nominal
 /// rotation gave −0.0017 ± 0.0003 at the default step against the exact
 /// −0.0054, marked reliable. Flatland's twin is its sensor-view test.

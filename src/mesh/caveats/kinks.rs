@@ -48,7 +48,7 @@ pub fn kinks(scene: &Scene) -> Vec<(Quantity, String)> {
 /// the face and `x`. Far from the origin a face's plane is known only to
 /// the rounding of its coordinates: a lamp tilted 9 ulps of 9·10⁵ off
 /// edge-on (10⁻⁹ rad) read I 54σ and ∂I/∂tz 350σ off, "reliable"
-/// (campaign; the bias went as 1/ulps, 3σ at 1 024).
+/// (seen in random scenes; the bias went as 1/ulps, 3σ at 1 024).
 fn edge_on_plane(
     scene: &Scene,
     x: glam::DVec3,
@@ -81,7 +81,7 @@ pub(super) fn crosses(v: glam::DVec3, n: glam::DVec3) -> bool {
 /// of a face (within [`kinks`]'s tolerance) but off the face itself, so
 /// moving it across that plane turns the face, seen edge-on, to face it
 /// from one side or the other (a lamp seen edge-on: transport's `∇z` read
-/// 0.400 at the origin and 0.417 at 9·10⁵, "reliable", in a campaign). A
+/// 0.400 at the origin and 0.417 at 9·10⁵, "reliable", in random scenes). A
 /// sensor on the face itself is not this (there the gradient along the
 /// normal would be the one-sided derivative from the side it faces; the
 /// scene checks refuse a sensor on an opaque face). One caveat per axis
