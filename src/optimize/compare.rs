@@ -41,8 +41,8 @@ pub struct Budget {
 /// A worked problem.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Problem {
-    /// Its scene file, relative to the crate's root (a file under a
-    /// `mesh` folder is a 3D scene, any other a flatland one).
+    /// Its scene file, relative to the crate's root (its points' number of
+    /// coordinates says its dimension).
     pub file: &'static str,
     /// The true offsets of an inverse problem, in the parameters' order;
     /// `None` for a design problem, whose answer a [`scan`] finds.
@@ -172,13 +172,13 @@ macro_rules! with_study {
 }
 
 impl Loaded {
-    /// Loads `path`: a 3D study if a folder on its path is called `mesh`,
-    /// else a flatland one.
+    /// Loads `path`: a 3D study if its points have three coordinates, else
+    /// a flatland one ([`crate::scene::file::dimension`], as
+    /// `geosens optimize` decides).
     pub fn load(path: &Path) -> Result<Loaded, Error> {
-        if path.components().any(|c| c.as_os_str() == "mesh") {
-            Ok(Loaded::Mesh(Box::new(crate::mesh::file::load_study(path)?)))
-        } else {
-            Ok(Loaded::Flat(Box::new(crate::flat::file::load_study(path)?)))
+        match crate::scene::file::dimension(path)? {
+            Some(3) => Ok(Loaded::Mesh(Box::new(crate::mesh::file::load_study(path)?))),
+            _ => Ok(Loaded::Flat(Box::new(crate::flat::file::load_study(path)?))),
         }
     }
 
@@ -698,6 +698,20 @@ pub const INVERSE_OCCLUDER: &str = include_str!("../../scenes/inverse_occluder.t
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every worked problem loads, in the dimension its file's points give,
+    /// with one truth per parameter.
+    #[test]
+    fn every_problem_loads_in_its_dimension() {
+        for p in PROBLEMS {
+            let loaded = Loaded::load(&resolve(p.file)).unwrap();
+            let mesh = matches!(loaded, Loaded::Mesh(_));
+            assert_eq!(mesh, p.file.starts_with("scenes/mesh/"), "{}", p.file);
+            if let Some(t) = p.truth {
+                assert_eq!(t.len(), loaded.names().len(), "{}", p.file);
+            }
+        }
+    }
 
     fn point(error: f64) -> Point {
         Point {
