@@ -456,16 +456,29 @@ impl<P: Primitive> Tree<P> {
         t_max: f64,
         skip: u32,
     ) -> Option<(f64, u32)> {
+        self.closest_hit_along(&P::ray(origin, dir), origin, dir, t_max, skip)
+    }
+
+    /// [`Tree::closest_hit`] with the primitives' form of the ray, `ray`,
+    /// made by the caller (who asks several trees the same).
+    #[inline]
+    pub(crate) fn closest_hit_along(
+        &self,
+        ray: &P::Ray,
+        origin: P::Vector,
+        dir: P::Vector,
+        t_max: f64,
+        skip: u32,
+    ) -> Option<(f64, u32)> {
         let clip = match self.plan(origin, dir, t_max) {
             Plan::Miss => return None,
-            Plan::Linear => return scan_closest(&self.prims, &P::ray(origin, dir), t_max, skip),
+            Plan::Linear => return scan_closest(&self.prims, ray, t_max, skip),
             Plan::Trace(clip) => clip,
         };
-        let ray = P::ray(origin, dir);
         let mut best = (t_max, NONE);
         self.traverse(&clip, |prims, r| {
             for p in prims {
-                if take(&mut best, p, &ray, t_max, skip) {
+                if take(&mut best, p, ray, t_max, skip) {
                     // Padded: a later equal-t, lower-index hit is still reached.
                     r.tmax = r.tmax.min(clip.bound(best.0));
                 }
@@ -480,15 +493,28 @@ impl<P: Primitive> Tree<P> {
     /// answer.
     #[inline]
     pub(crate) fn any_hit(&self, origin: P::Vector, dir: P::Vector, t_max: f64, skip: u32) -> bool {
+        self.any_hit_along(&P::ray(origin, dir), origin, dir, t_max, skip)
+    }
+
+    /// [`Tree::any_hit`] with the primitives' form of the ray, `ray`, made
+    /// by the caller.
+    #[inline]
+    pub(crate) fn any_hit_along(
+        &self,
+        ray: &P::Ray,
+        origin: P::Vector,
+        dir: P::Vector,
+        t_max: f64,
+        skip: u32,
+    ) -> bool {
         let clip = match self.plan(origin, dir, t_max) {
             Plan::Miss => return false,
-            Plan::Linear => return scan_any(&self.prims, &P::ray(origin, dir), t_max, skip),
+            Plan::Linear => return scan_any(&self.prims, ray, t_max, skip),
             Plan::Trace(clip) => clip,
         };
-        let ray = P::ray(origin, dir);
         let mut found = false;
         self.traverse(&clip, |prims, _| {
-            found = scan_any(prims, &ray, t_max, skip);
+            found = scan_any(prims, ray, t_max, skip);
             !found // false halts the traversal
         });
         found

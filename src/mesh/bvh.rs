@@ -135,7 +135,7 @@ fn nearest_hit2(tri: &[DVec3; 3]) -> f64 {
 /// A query ray prepared for [`intersect`]: the shear that takes it to the
 /// `kz` axis from the origin, `kz` its largest direction component.
 #[derive(Debug, Clone, Copy)]
-struct Shear {
+pub struct Shear {
     origin: DVec3,
     /// `e_kx − (d_kx / d_kz) e_kz` and `e_ky − (d_ky / d_kz) e_kz`, where
     /// `(kx, ky, kz)` is a cyclic permutation of the axes: their dot
@@ -217,6 +217,10 @@ impl Shear {
         (t > 0.0 && t * t * self.len2 > min2).then_some(t)
     }
 }
+
+/// A ray in the form the triangle test takes, made once by
+/// [`TriangleBvh::ray`] for several casters.
+pub type CastRay = Shear;
 
 /// A finite triangle with its index in the caller's list.
 #[derive(Debug, Clone, Copy)]
@@ -336,6 +340,41 @@ impl TriangleBvh {
         skip: u32,
     ) -> Option<(f64, u32)> {
         self.tree.closest_hit(origin, dir, t_max, skip)
+    }
+
+    /// `origin + t dir` in the form [`TriangleBvh::closest_hit_along`] and
+    /// [`TriangleBvh::any_hit_along`] take.
+    #[inline]
+    pub fn ray(origin: DVec3, dir: DVec3) -> CastRay {
+        Shear::new(origin, dir)
+    }
+
+    /// [`TriangleBvh::closest_hit`] with `ray` made by [`TriangleBvh::ray`]
+    /// of the same `origin` and `dir` (a caller asking several casters
+    /// makes it once).
+    #[inline]
+    pub fn closest_hit_along(
+        &self,
+        ray: &CastRay,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        skip: u32,
+    ) -> Option<(f64, u32)> {
+        self.tree.closest_hit_along(ray, origin, dir, t_max, skip)
+    }
+
+    /// [`TriangleBvh::any_hit`] with `ray` made by [`TriangleBvh::ray`].
+    #[inline]
+    pub fn any_hit_along(
+        &self,
+        ray: &CastRay,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        skip: u32,
+    ) -> bool {
+        self.tree.any_hit_along(ray, origin, dir, t_max, skip)
     }
 
     /// Whether any triangle other than `skip` (`u32::MAX`: none) is crossed

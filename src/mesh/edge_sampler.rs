@@ -7,12 +7,11 @@
 //! "Boundary terms".
 use super::camera::PixelEdges;
 use super::edges::{Edge, EdgeFacts, EdgeTree};
+use super::part::MeshPart;
 use super::scene::Scene;
 use super::sensor_view::SensorView;
-use crate::path::{NO_PRIM, Prim, Surface};
-use glam::DVec3;
-use std::collections::HashMap;
-use std::sync::OnceLock;
+use crate::path::{NO_PRIM, Surface};
+use std::sync::{Arc, OnceLock};
 
 /// Most edges in a tree for which the edge itself is also drawn by the
 /// length of its arc with a lamp behind (every edge's arc and lamp parts
@@ -22,7 +21,7 @@ pub(super) const LAMP_EDGES: usize = 64;
 /// The edges of the opaque meshes that can be discontinuities, with what
 /// the boundary terms and the warp need of them.
 #[derive(Debug, Clone)]
-pub(super) struct EdgeTables {
+pub(crate) struct EdgeTables {
     /// The edges.
     pub(super) edges: Vec<Edge>,
     /// Per edge, the weight with which the boundary terms draw it: its
@@ -57,125 +56,74 @@ pub(super) struct EdgeTables {
 pub(super) const LAMP_SET: usize = 16;
 
 impl EdgeTables {
-    /// The edges of `scene`'s opaque meshes (`normals`: per triangle, in
-    /// [`Space`]'s order), their weights and facts, and their hierarchies.
-    pub(super) fn new(scene: &Scene, normals: &[DVec3]) -> EdgeTables {
+    /// The edges of `scene`'s opaque meshes, their weights and facts, and
+    /// their hierarchies, assembled from the meshes' own (`parts`, in the
+    /// scene's order): each hierarchy joins whole meshes' trees
+    /// ([`EdgeTree::join`]), so no mesh's edges are found or sorted again.
+    pub(super) fn new(scene: &Scene, parts: &[Arc<MeshPart>]) -> EdgeTables {
+        let shapes = scene.shapes();
         let mut edges = Vec::new();
         let mut edge_weight = Vec::new();
-        let mut first = 0u32;
-        for (k, s) in scene.shapes().iter().enumerate() {
-            let first_of_shape = first;
-            first += s.triangles.len() as u32;
-            let first = first_of_shape;
-            if !s.surface.is_opaque() {
-                continue;
-            }
-            // Edges by their vertex pair, in first-seen order (deterministic).
-            let mut index: HashMap<(u32, u32), usize> = HashMap::new();
-            let mut pairs: Vec<((u32, u32), [Prim; 2])> = Vec::new();
-            for (i, t) in s.triangles.iter().enumerate() {
-                for e in 0..3 {
-                    let (a, b) = (t[e], t[(e + 1) % 3]);
-                    let key = (a.min(b), a.max(b));
-                    let p = first + i as u32;
-                    match index.get(&key) {
-                        Some(&m) => {
-                            if pairs[m].1[1] == NO_PRIM {
-                                pairs[m].1[1] = p;
-                            }
-                        }
-                        None => {
-                            index.insert(key, pairs.len());
-                            pairs.push((key, [p, NO_PRIM]));
-                        }
-                    }
+        let mut edge_facts = Vec::new();
+        // Per mesh, its edges' first index.
+        let mut first_edge = Vec::with_capacity(shapes.len());
+        let mut first_tri = 0;
+        for (k, (s, part)) in shapes.iter().zip(parts).enumerate() {
+            let own = part.edges(s);
+            first_edge.push(edges.len() as u32);
+            edges.extend(own.edges.iter().map(|e| {
+                Edge {
+                    faces: e
+                        .faces
+                        .map(|f| if f == NO_PRIM { NO_PRIM } else { f + first_tri }),
+                    shape: k as u32,
+                    ..*e
                 }
-            }
-            for ((a, b), faces) in pairs {
-                let (a, b) = (s.vertices[a as usize], s.vertices[b as usize]);
-                let turn = if faces[1] == NO_PRIM {
-                    1.0
-                } else {
-                    let (n0, n1) = (normals[faces[0] as usize], normals[faces[1] as usize]);
-                    n0.cross(n1).length().atan2(n0.dot(n1)) / std::f64::consts::PI
-                };
-                let w = (b - a).length() * turn;
-                if w > 0.0 {
-                    edges.push(Edge {
-                        a,
-                        b,
-                        faces,
-                        shape: k as u32,
-                    });
-                    edge_weight.push(w);
-                }
-            }
+            }));
+            edge_weight.extend_from_slice(&own.weights);
+            edge_facts.extend_from_slice(&own.facts);
+            first_tri += part.len();
         }
         let params = scene.parameters().len();
-        let moving = |k: u32| (0..params).any(|j| scene.parameter_shape(j) == k);
-        let edge_facts: Vec<EdgeFacts> = edges
-            .iter()
-            .map(|e| {
-                let n0 = normals[e.faces[0] as usize];
-                let open = e.faces[1] == NO_PRIM;
-                let n1 = if open {
-                    n0
-                } else {
-                    normals[e.faces[1] as usize]
-                };
-                let reflector = matches!(
-                    scene.shapes()[e.shape as usize].surface,
-                    Surface::Reflector { .. }
-                );
-                EdgeFacts {
-                    normals: [n0, n1],
-                    always: open || reflector,
-                }
-            })
-            .collect();
-        let all_ids: Vec<u32> = (0..edges.len() as u32).collect();
-        let moving_ids: Vec<u32> = (0..edges.len() as u32)
-            .filter(|&i| moving(edges[i as usize].shape))
-            .collect();
-        let lamp = |i: &u32| {
-            matches!(scene.shapes()[edges[*i as usize].shape as usize].surface,
-                Surface::Emitter { radiance } if radiance > 0.0)
-        };
-        let lamps: Vec<u32> = all_ids.iter().copied().filter(lamp).collect();
+        let moving = |k: usize| (0..params).any(|j| scene.parameter_shape(j) as usize == k);
+        let lamp =
+            |k: usize| matches!(shapes[k].surface, Surface::Emitter { radiance } if radiance > 0.0);
+        let count = |k: usize| parts[k].edges(&shapes[k]).edges.len();
+        let lamp_edges: usize = (0..shapes.len()).filter(|&k| lamp(k)).map(count).sum();
         // Only in small scenes, as the lamp parts (`LAMP_EDGES`): over a
         // large mesh every point costs casts through a deep hierarchy (on
         // mesh_perf's sphere of 10^5 triangles transport ran 2.8 times
         // slower per path for 1.7 times less variance).
-        let lamp_set = if lamps.len() <= LAMP_SET && all_ids.len() - lamps.len() <= LAMP_EDGES {
-            let moving_lamps = moving_ids.iter().copied().filter(lamp).collect();
-            [moving_lamps, lamps]
+        let small = lamp_edges <= LAMP_SET && edges.len() - lamp_edges <= LAMP_EDGES;
+        let ids_of = |k: usize| first_edge[k]..first_edge[k] + count(k) as u32;
+        let lamp_set = if small {
+            let of = |pick: &dyn Fn(usize) -> bool| -> Vec<u32> {
+                (0..shapes.len())
+                    .filter(|&k| lamp(k) && pick(k))
+                    .flat_map(ids_of)
+                    .collect()
+            };
+            [of(&moving), of(&|_| true)]
         } else {
             [Vec::new(), Vec::new()]
         };
-        let drawn = |ids: &[u32]| -> Vec<u32> {
-            ids.iter()
-                .copied()
-                .filter(|i| !lamp_set[1].contains(i))
-                .collect()
+        // The lamp set is whole meshes: the drawn hierarchies join the
+        // trees of the meshes outside it.
+        let join = |pick: &dyn Fn(usize) -> bool| {
+            let chosen: Vec<(&EdgeTree, u32)> = (0..shapes.len())
+                .filter(|&k| pick(k))
+                .map(|k| (&parts[k].edges(&shapes[k]).tree, first_edge[k]))
+                .collect();
+            EdgeTree::join(&chosen, &edges, &edge_facts, &edge_weight)
         };
-        let all_drawn = EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&all_ids));
-        let moving_drawn = EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&moving_ids));
-        let shapes = scene.shapes().len();
-        let shape_drawn = (0..shapes as u32)
-            .map(|k| {
-                let ids: Vec<u32> = moving_ids
-                    .iter()
-                    .copied()
-                    .filter(|&i| edges[i as usize].shape == k)
-                    .collect();
-                EdgeTree::new(&edges, &edge_facts, &edge_weight, drawn(&ids))
-            })
+        let drawn = |k: usize| !(small && lamp(k));
+        let all_edges = join(&|_| true);
+        let all_drawn = join(&drawn);
+        let moving_drawn = join(&|k| moving(k) && drawn(k));
+        let shape_drawn = (0..shapes.len())
+            .map(|k| join(&|l| l == k && moving(k) && drawn(k)))
             .collect();
-        let mut shape_edges = vec![0u32; shapes];
-        for e in &edges {
-            shape_edges[e.shape as usize] += 1;
-        }
-        let all_edges = EdgeTree::new(&edges, &edge_facts, &edge_weight, all_ids);
+        let shape_edges = (0..shapes.len()).map(|k| count(k) as u32).collect();
         EdgeTables {
             shape_drawn,
             shape_edges,
@@ -190,13 +138,12 @@ impl EdgeTables {
     }
 }
 
-/// The space's edge caches, each built on first use: only the derivative
-/// methods ask (not the intensity estimator, nor the displaced scenes of
+/// The space's edge caches that depend on the sensor, each built on first
+/// use (the edge tables themselves are the scene's: see
+/// [`Scene`](super::scene::Scene)): only the derivative methods ask (not the intensity estimator, nor the displaced scenes of
 /// finite differences).
 #[derive(Debug, Clone)]
 pub struct EdgeSampler {
-    /// The edges and their hierarchies.
-    pub(super) tables: OnceLock<EdgeTables>,
     /// The moving edges each camera pixel sees (built on first use, by the
     /// derivative methods).
     pub(super) pixel_edges: OnceLock<PixelEdges>,
@@ -215,7 +162,6 @@ impl EdgeSampler {
     /// Empty caches for a scene of `shapes` meshes.
     pub(super) fn new(shapes: usize) -> EdgeSampler {
         EdgeSampler {
-            tables: OnceLock::new(),
             pixel_edges: OnceLock::new(),
             sensor_view: OnceLock::new(),
             sensor_lamps: [OnceLock::new(), OnceLock::new()],

@@ -136,6 +136,47 @@ pub fn is_discontinuity(e: &Edge, facts: &EdgeFacts, x: DVec3) -> bool {
     !((s0 > 0.0 && s1 > 0.0) || (s0 < 0.0 && s1 < 0.0))
 }
 
+/// The node over the edges `ids` (its box, normal cone and weight), as a
+/// leaf holding them from place 0.
+fn node_of(ids: &[u32], edges: &[Edge], facts: &[EdgeFacts], weights: &[f64]) -> Node {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    let mut sum = DVec3::ZERO;
+    let mut always = false;
+    let mut weight = 0.0;
+    for &i in ids {
+        let e = &edges[i as usize];
+        lo = lo.min(e.a).min(e.b);
+        hi = hi.max(e.a).max(e.b);
+        let f = &facts[i as usize];
+        sum += f.normals[0] + f.normals[1];
+        always |= f.always || e.faces[1] == NO_PRIM;
+        weight += weights[i as usize];
+    }
+    let axis = sum.normalize_or_zero();
+    // The cone's half-angle by its cosine, the least n·axis (no acos per
+    // normal: the build runs over every edge at every level).
+    let cos_half = if axis == DVec3::ZERO {
+        -1.0
+    } else {
+        ids.iter()
+            .flat_map(|&i| facts[i as usize].normals)
+            .map(|n| n.dot(axis).clamp(-1.0, 1.0))
+            .fold(1.0, f64::min)
+    };
+    Node {
+        lo,
+        hi,
+        axis,
+        cos_half,
+        sin_half: (1.0 - cos_half * cos_half).max(0.0).sqrt(),
+        unbounded: cos_half <= 0.0,
+        always,
+        weight,
+        first: 0,
+        count: ids.len() as u32,
+    }
+}
+
 impl EdgeTree {
     /// The tree over the edges `ids` of `edges`.
     pub fn new(edges: &[Edge], facts: &[EdgeFacts], weights: &[f64], ids: Vec<u32>) -> EdgeTree {
@@ -161,12 +202,17 @@ impl EdgeTree {
         });
         let n = tree.order.len();
         tree.build(0, 0, n, edges, facts, weights);
-        let last = tree.order.iter().max().map_or(0, |&i| i as usize + 1);
-        tree.place = vec![u32::MAX; last];
-        for (k, &i) in tree.order.iter().enumerate() {
-            tree.place[i as usize] = k as u32;
-        }
+        tree.index_places();
         tree
+    }
+
+    /// Fills `place` from `order`.
+    fn index_places(&mut self) {
+        let last = self.order.iter().max().map_or(0, |&i| i as usize + 1);
+        self.place = vec![u32::MAX; last];
+        for (k, &i) in self.order.iter().enumerate() {
+            self.place[i as usize] = k as u32;
+        }
     }
 
     /// The edges in the tree, in leaf order.
@@ -193,52 +239,17 @@ impl EdgeTree {
         facts: &[EdgeFacts],
         weights: &[f64],
     ) {
-        let ids = &mut self.order[start..end];
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        let mut sum = DVec3::ZERO;
-        let mut always = false;
-        let mut weight = 0.0;
-        for &i in ids.iter() {
-            let e = &edges[i as usize];
-            lo = lo.min(e.a).min(e.b);
-            hi = hi.max(e.a).max(e.b);
-            let f = &facts[i as usize];
-            sum += f.normals[0] + f.normals[1];
-            always |= f.always || e.faces[1] == NO_PRIM;
-            weight += weights[i as usize];
-        }
-        let axis = sum.normalize_or_zero();
-        // The cone's half-angle by its cosine, the least n·axis (no acos per
-        // normal: the build runs over every edge at every level).
-        let cos_half = if axis == DVec3::ZERO {
-            -1.0
-        } else {
-            ids.iter()
-                .flat_map(|&i| facts[i as usize].normals)
-                .map(|n| n.dot(axis).clamp(-1.0, 1.0))
-                .fold(1.0, f64::min)
-        };
-        let mut this = Node {
-            lo,
-            hi,
-            axis,
-            cos_half,
-            sin_half: (1.0 - cos_half * cos_half).max(0.0).sqrt(),
-            unbounded: cos_half <= 0.0,
-            always,
-            weight,
-            first: start as u32,
-            count: (end - start) as u32,
-        };
+        let mut this = node_of(&self.order[start..end], edges, facts, weights);
+        this.first = start as u32;
         if end - start > LEAF {
             // Median split on the longest axis of the midpoints' box.
-            let k = (hi - lo).max_position();
+            let k = (this.hi - this.lo).max_position();
             let mid = |i: &u32| {
                 let e = &edges[*i as usize];
                 (e.a + e.b)[k]
             };
             let half = (end - start) / 2;
-            ids.select_nth_unstable_by(half, |a, b| mid(a).total_cmp(&mid(b)));
+            self.order[start..end].select_nth_unstable_by(half, |a, b| mid(a).total_cmp(&mid(b)));
             let left = self.nodes.len();
             this.first = left as u32;
             this.count = 0;
@@ -251,6 +262,87 @@ impl EdgeTree {
         } else {
             self.nodes[node] = this;
         }
+    }
+
+    /// The tree over the union of disjoint `parts`, each a tree built by
+    /// [`EdgeTree::new`] over edges numbered from 0 and here shifted by its
+    /// offset into `edges`: the parts' nodes are copied whole (one mesh's
+    /// tree is built once and serves every scene that holds the mesh
+    /// unmoved), under top nodes that split the parts at the median of their
+    /// boxes' centres on the longest axis, as [`EdgeTree::new`] splits
+    /// edges. One part gives exactly the tree [`EdgeTree::new`] builds over
+    /// its shifted edges.
+    pub fn join(
+        parts: &[(&EdgeTree, u32)],
+        edges: &[Edge],
+        facts: &[EdgeFacts],
+        weights: &[f64],
+    ) -> EdgeTree {
+        let parts: Vec<(&EdgeTree, u32)> = parts
+            .iter()
+            .copied()
+            .filter(|(t, _)| !t.nodes.is_empty())
+            .collect();
+        let mut tree = EdgeTree::default();
+        if parts.is_empty() {
+            return tree;
+        }
+        tree.nodes.push(parts[0].0.nodes[0]);
+        let mut chosen: Vec<usize> = (0..parts.len()).collect();
+        tree.join_parts(0, &mut chosen, &parts, edges, facts, weights);
+        tree.index_places();
+        tree
+    }
+
+    /// Node `node` over the parts `chosen` (see [`EdgeTree::join`]).
+    fn join_parts(
+        &mut self,
+        node: usize,
+        chosen: &mut [usize],
+        parts: &[(&EdgeTree, u32)],
+        edges: &[Edge],
+        facts: &[EdgeFacts],
+        weights: &[f64],
+    ) {
+        if let [one] = chosen {
+            let (part, offset) = parts[*one];
+            let start = self.order.len() as u32;
+            self.order.extend(part.order.iter().map(|&i| i + offset));
+            // The part's node i ≥ 1 goes to base + i − 1, its root to `node`.
+            let base = self.nodes.len() as u32;
+            let shift = |n: Node| Node {
+                first: if n.count > 0 {
+                    n.first + start
+                } else {
+                    base + n.first - 1
+                },
+                ..n
+            };
+            self.nodes[node] = shift(part.nodes[0]);
+            self.nodes.extend(part.nodes[1..].iter().map(|&n| shift(n)));
+            return;
+        }
+        let ids: Vec<u32> = chosen
+            .iter()
+            .flat_map(|&p| parts[p].0.order.iter().map(move |&i| i + parts[p].1))
+            .collect();
+        let mut this = node_of(&ids, edges, facts, weights);
+        let k = (this.hi - this.lo).max_position();
+        let centre = |p: &usize| {
+            let root = &parts[*p].0.nodes[0];
+            (root.lo + root.hi)[k]
+        };
+        chosen.sort_by(|a, b| centre(a).total_cmp(&centre(b)).then(a.cmp(b)));
+        let half = chosen.len() / 2;
+        let left = self.nodes.len();
+        this.first = left as u32;
+        this.count = 0;
+        self.nodes[node] = this;
+        self.nodes.push(this);
+        self.nodes.push(this);
+        let (l, r) = chosen.split_at_mut(half);
+        self.join_parts(left, l, parts, edges, facts, weights);
+        self.join_parts(left + 1, r, parts, edges, facts, weights);
     }
 
     /// Whether node `i` may hold a discontinuity seen from `x` (false when

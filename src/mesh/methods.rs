@@ -91,13 +91,13 @@ impl Model for Scene {
         Scene::sensor(self)
     }
     fn with_sensor(&self, sensor: Sensor) -> Result<Self, Error> {
-        Scene::new(self.shapes().to_vec(), self.parameters().to_vec(), sensor)
+        Scene::with_sensor(self, sensor)
     }
     fn posed(&self, offsets: &[f64]) -> Result<Self, Error> {
         let params = self.parameters();
         let owner: Vec<u32> = (0..params.len()).map(|j| self.parameter_shape(j)).collect();
         let (shapes, params) = pose(self.shapes(), params, &owner, offsets)?;
-        Scene::new(shapes, params, self.sensor())
+        self.moved(shapes, params)
     }
     fn offset_rate(&self, j: usize, offset: f64) -> f64 {
         crate::scene::pose::Pose::offset_rate(&self.parameters()[j].motion, offset)

@@ -31,6 +31,7 @@ pub mod knots;
 pub mod lobe;
 pub mod methods;
 mod obj_lines;
+mod part;
 pub mod poles;
 pub mod scene;
 pub mod sensor_view;

@@ -9,6 +9,7 @@ use super::camera::{CameraFrame, PixelEdges};
 use super::edge_sampler::{EdgeSampler, EdgeTables};
 pub use super::edges::Edge;
 use super::lobe::SpaceLobe;
+use super::part::MeshPart;
 use super::poles::PoleTable;
 use super::scene::{Scene, Sensor as SceneSensor};
 use super::sensor_view::SensorView;
@@ -26,6 +27,74 @@ use std::sync::Arc;
 /// (`Space::touches_only`) before it reports the next hit as it is.
 const MAX_TOUCHES: usize = 8;
 
+/// Ray casting against several meshes, each through its own
+/// [`TriangleBvh`], triangles numbered as [`Space`] numbers them (meshes in
+/// order): exactly the answers of one caster over all the triangles, since
+/// each mesh's tree answers as a scan of its triangles and a later mesh is
+/// asked only for hits strictly nearer than the best so far (a tie stays
+/// with the lower index, as in one scan).
+#[derive(Debug, Clone)]
+pub(super) struct MeshCaster {
+    /// The meshes cast against, with the index of their first triangle.
+    parts: Vec<(Arc<MeshPart>, Prim)>,
+}
+
+impl MeshCaster {
+    /// A caster over the meshes `pick` keeps.
+    fn new(parts: &[Arc<MeshPart>], pick: impl Fn(usize) -> bool) -> MeshCaster {
+        let mut first = 0;
+        let mut chosen = Vec::new();
+        for (k, p) in parts.iter().enumerate() {
+            if pick(k) && p.len() > 0 {
+                chosen.push((p.clone(), first));
+            }
+            first += p.len();
+        }
+        MeshCaster { parts: chosen }
+    }
+
+    /// `skip` in `part`'s numbering (`NO_PRIM` if it is not there).
+    #[inline(always)]
+    fn local(part: &MeshPart, first: Prim, skip: Prim) -> Prim {
+        let i = skip.wrapping_sub(first);
+        if i < part.len() { i } else { NO_PRIM }
+    }
+
+    /// [`TriangleBvh::closest_hit`](super::bvh::TriangleBvh::closest_hit)
+    /// over all the meshes.
+    #[inline]
+    pub(super) fn closest_hit(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        skip: Prim,
+    ) -> Option<(f64, Prim)> {
+        let ray = TriangleBvh::ray(origin, dir);
+        let mut best = None;
+        let mut t_max = t_max;
+        for (part, first) in &self.parts {
+            let skip = Self::local(part, *first, skip);
+            if let Some((t, i)) = part.bvh.closest_hit_along(&ray, origin, dir, t_max, skip) {
+                t_max = t;
+                best = Some((t, first + i));
+            }
+        }
+        best
+    }
+
+    /// [`TriangleBvh::any_hit`](super::bvh::TriangleBvh::any_hit) over all
+    /// the meshes.
+    #[inline]
+    pub(super) fn any_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, skip: Prim) -> bool {
+        let ray = TriangleBvh::ray(origin, dir);
+        self.parts.iter().any(|(part, first)| {
+            let skip = Self::local(part, *first, skip);
+            part.bvh.any_hit_along(&ray, origin, dir, t_max, skip)
+        })
+    }
+}
+
 /// A 3D scene with the tables the estimators need.
 #[derive(Debug, Clone)]
 pub struct Space {
@@ -36,11 +105,11 @@ pub struct Space {
     pub(super) owner: Vec<u32>,
     /// Unit normal of each triangle, outward for closed meshes.
     pub(super) normals: Vec<DVec3>,
-    pub(super) caster: TriangleBvh,
-    /// Opaque triangles only (visibility), the map from a triangle to its
-    /// index there.
-    opaque: TriangleBvh,
-    opaque_index: Vec<u32>,
+    /// The meshes' own tables, in order.
+    pub(super) parts: Vec<Arc<MeshPart>>,
+    /// Every mesh's caster, and the opaque meshes' (visibility).
+    pub(super) caster: MeshCaster,
+    pub(super) opaque: MeshCaster,
     /// Emitting triangles with their cumulative area, and the total.
     pub(super) emitters: Vec<(Prim, f64)>,
     emitter_area: f64,
@@ -58,30 +127,20 @@ pub struct Space {
 }
 
 impl Space {
-    /// The tables of `scene`.
+    /// The tables of `scene`, assembled from its meshes' own (built on
+    /// first use and shared by the scenes that hold a mesh unmoved).
     pub fn new(scene: Arc<Scene>) -> Space {
-        let mut tris = Vec::new();
-        let mut owner = Vec::new();
-        let mut normals = Vec::new();
-        for (k, s) in scene.shapes().iter().enumerate() {
-            for i in 0..s.triangles.len() {
-                let t = s.triangle(i);
-                tris.push(t);
-                owner.push(k as u32);
-                normals.push((t[1] - t[0]).cross(t[2] - t[0]).normalize());
-            }
+        let parts: Vec<Arc<MeshPart>> = (0..scene.shapes().len()).map(|k| scene.part(k)).collect();
+        let total: usize = parts.iter().map(|p| p.tris.len()).sum();
+        let mut tris = Vec::with_capacity(total);
+        let mut owner = Vec::with_capacity(total);
+        let mut normals = Vec::with_capacity(total);
+        for (k, p) in parts.iter().enumerate() {
+            tris.extend_from_slice(&p.tris);
+            normals.extend_from_slice(&p.normals);
+            owner.extend(std::iter::repeat_n(k as u32, p.tris.len()));
         }
-        let mut opaque_tris = Vec::new();
-        let opaque_index = (0..tris.len())
-            .map(|i| {
-                if scene.shapes()[owner[i] as usize].surface.is_opaque() {
-                    opaque_tris.push(tris[i]);
-                    (opaque_tris.len() - 1) as u32
-                } else {
-                    NO_PRIM
-                }
-            })
-            .collect();
+        let opaque = |k: usize| scene.shapes()[k].surface.is_opaque();
         let mut emitter_area = 0.0;
         let emitters = (0..tris.len())
             .filter(|&i| {
@@ -107,9 +166,9 @@ impl Space {
                 let coefficients = s.medium.map(|m| Coefficients { ks: m.ks, ke: m.ke });
                 (coefficients, &s.vertices[..], scene.parent_medium(k as u32))
             })),
-            caster: TriangleBvh::new(tris.clone()),
-            opaque: TriangleBvh::new(opaque_tris),
-            opaque_index,
+            caster: MeshCaster::new(&parts, |_| true),
+            opaque: MeshCaster::new(&parts, opaque),
+            parts,
             scene,
             tris,
             owner,
@@ -133,12 +192,12 @@ impl Space {
         &self.edge_tables().edges
     }
 
-    /// The edge tables, built on first use.
+    /// The edge tables, built on first use and shared by the scenes that
+    /// differ from this one in their sensor only.
     #[inline]
     pub(super) fn edge_tables(&self) -> &EdgeTables {
-        self.sampler
-            .tables
-            .get_or_init(|| EdgeTables::new(&self.scene, &self.normals))
+        self.scene
+            .edge_tables(|| EdgeTables::new(&self.scene, &self.parts))
     }
 
     /// What the sensor's point (a probe's point, a camera's pinhole) sees
@@ -251,11 +310,6 @@ impl Geometry for Space {
     fn visible(&self, x: DVec3, y: DVec3, skip: Prim) -> bool {
         let d = y - x;
         let len = d.length();
-        let skip = if skip == NO_PRIM {
-            NO_PRIM
-        } else {
-            self.opaque_index[skip as usize]
-        };
         !self.opaque.any_hit(
             x,
             d / len,

@@ -96,8 +96,10 @@ pub fn pose<M: Pose, S: Posable<V = M::V> + Clone>(
     }
     let mut shapes = shapes.to_vec();
     let mut posed = parameters.to_vec();
+    // An offset of 0 leaves its shape as it is, bit for bit (a turn by 0
+    // would round): an unmoved mesh keeps its tables.
     for (j, p) in parameters.iter().enumerate() {
-        if !p.motion.is_translation() {
+        if !p.motion.is_translation() && offsets[j] != 0.0 {
             let k = parameter_shape[j] as usize;
             for v in shapes[k].vertices_mut() {
                 *v = p.motion.apply(*v, offsets[j]);
@@ -105,7 +107,11 @@ pub fn pose<M: Pose, S: Posable<V = M::V> + Clone>(
         }
     }
     for (j, p) in parameters.iter().enumerate() {
-        let Some(d) = p.motion.translation(offsets[j]) else {
+        let Some(d) = p
+            .motion
+            .translation(offsets[j])
+            .filter(|_| offsets[j] != 0.0)
+        else {
             continue;
         };
         let k = parameter_shape[j];

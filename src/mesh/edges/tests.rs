@@ -161,3 +161,89 @@ fn the_probability_of_an_edge_is_that_of_its_draws() {
         }
     }
 }
+
+/// 200 open edges in a box, as five meshes of 40: the hierarchy joined
+/// from the meshes' own trees draws each edge with the probability it
+/// reports (a fine grid of `u` against the reported probabilities), every
+/// edge can be drawn, and one mesh's tree joined alone is the tree built
+/// over its edges in the scene's numbering (the same draws, bit for bit).
+#[test]
+fn a_tree_joined_from_meshes_draws_as_it_reports() {
+    let mut state = 3u64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut edges, mut facts, mut weights) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..200 {
+        // Each mesh in its own part of the box, as meshes that do not cross.
+        let c = DVec3::new((k / 40) as f64 - 2.0, 0.0, 0.0);
+        let a = c + DVec3::new(next() * 0.8, next() * 4.0 - 2.0, next() * 2.0);
+        let b = a + DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5) * 0.6;
+        edges.push(Edge {
+            a,
+            b,
+            faces: [0, NO_PRIM],
+            shape: (k / 40) as u32,
+        });
+        facts.push(EdgeFacts {
+            normals: [DVec3::Z; 2],
+            always: true,
+        });
+        weights.push((b - a).length());
+    }
+    let local: Vec<EdgeTree> = (0..5)
+        .map(|m| {
+            let r = 40 * m..40 * (m + 1);
+            EdgeTree::new(
+                &edges[r.clone()],
+                &facts[r.clone()],
+                &weights[r],
+                (0..40).collect(),
+            )
+        })
+        .collect();
+    let parts: Vec<(&EdgeTree, u32)> = local.iter().zip((0..5).map(|m| 40 * m)).collect();
+    let tree = EdgeTree::join(&parts, &edges, &facts, &weights);
+    let mut order = tree.edges().to_vec();
+    order.sort_unstable();
+    assert_eq!(order, (0..200).collect::<Vec<u32>>());
+    for x in [DVec3::new(0.1, -0.2, -1.0), DVec3::new(1.3, 0.2, 1.0)] {
+        let n = 400_000;
+        let mut drawn: Vec<(u32, f64)> = vec![(0, 0.0); 200];
+        for k in 0..n {
+            let u = (k as f64 + 0.5) / n as f64;
+            let (e, p, rest) = tree.sample(x, u, &edges, &facts, &weights).unwrap();
+            assert!((0.0..1.0).contains(&rest));
+            let slot = &mut drawn[e as usize];
+            if slot.0 > 0 {
+                assert_eq!(slot.1, p, "edge {e}: one probability per edge");
+            }
+            *slot = (slot.0 + 1, p);
+        }
+        let total: f64 = drawn.iter().map(|d| d.1).sum();
+        assert!((total - 1.0).abs() < 1e-12, "Σ p = {total}");
+        for (e, &(count, p)) in drawn.iter().enumerate() {
+            assert!(count > 0, "edge {e} never drawn");
+            let share = count as f64 / n as f64;
+            assert!(
+                (share - p).abs() < 40.0 / n as f64,
+                "edge {e}: {share} against {p}"
+            );
+        }
+    }
+    // One mesh joined alone: the tree over its edges, numbered in the scene.
+    let alone = EdgeTree::join(&[(&local[2], 80)], &edges, &facts, &weights);
+    let built = EdgeTree::new(&edges, &facts, &weights, (80..120).collect());
+    assert_eq!(alone.edges(), built.edges());
+    let x = DVec3::new(0.3, 0.1, 0.5);
+    for k in 0..1000 {
+        let u = (k as f64 + 0.5) / 1000.0;
+        assert_eq!(
+            alone.sample(x, u, &edges, &facts, &weights),
+            built.sample(x, u, &edges, &facts, &weights)
+        );
+    }
+}

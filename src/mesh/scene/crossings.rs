@@ -30,8 +30,14 @@ impl Aabb {
 /// triangles inside the other mesh's box are swept over x against each
 /// other, and the pairs whose boxes meet get the exact test
 /// ([`triangles_within`]). A large mesh beside small ones thus costs one
-/// pass over its triangles per neighbour.
-pub(super) fn check_crossings(shapes: &[Shape], size: f64) -> Result<(), Error> {
+/// pass over its triangles per neighbour. With `only`, just the pairs that
+/// hold a mesh it marks (the others are known to be apart).
+pub(super) fn check_crossings(
+    shapes: &[Shape],
+    size: f64,
+    only: Option<&[bool]>,
+) -> Result<(), Error> {
+    let asked = |k: usize, l: usize| only.is_none_or(|m| m[k] || m[l]);
     let tol = TOUCH_DISTANCE * size;
     let boxes: Vec<Aabb> = shapes.iter().map(|s| Aabb::of(&s.vertices)).collect();
     let mut order: Vec<usize> = (0..shapes.len()).collect();
@@ -41,7 +47,7 @@ pub(super) fn check_crossings(shapes: &[Shape], size: f64) -> Result<(), Error> 
             if boxes[l].lo.x > boxes[k].hi.x + tol {
                 break;
             }
-            if boxes[k].meets(&boxes[l], tol) {
+            if asked(k, l) && boxes[k].meets(&boxes[l], tol) {
                 check_pair(shapes, k.min(l), k.max(l), &boxes, tol)?;
             }
         }
@@ -105,10 +111,18 @@ fn check_pair(shapes: &[Shape], k: usize, l: usize, boxes: &[Aabb], tol: f64) ->
 /// - an edge: they must not lie in one plane on the same side of it (a
 ///   fold; in one plane on either side is a flat face).
 ///
-/// Flatland refuses a polygon that intersects itself likewise.
-pub(super) fn check_self_crossings(shapes: &[Shape], size: f64) -> Result<(), Error> {
+/// Flatland refuses a polygon that intersects itself likewise. With
+/// `only`, just the meshes it marks.
+pub(super) fn check_self_crossings(
+    shapes: &[Shape],
+    size: f64,
+    only: Option<&[bool]>,
+) -> Result<(), Error> {
     let tol = TOUCH_DISTANCE * size;
-    for s in shapes {
+    for (k, s) in shapes.iter().enumerate() {
+        if only.is_some_and(|m| !m[k]) {
+            continue;
+        }
         let mut items: Vec<(Aabb, u32)> = (0..s.triangles.len())
             .map(|i| (Aabb::of(&s.triangle(i)), i as u32))
             .collect();

@@ -10,8 +10,11 @@
 //! exact predicates it uses (triangle distances, winding numbers) and `repr`
 //! the file forms of the tagged enums.
 use crate::error::Error;
+use crate::mesh::edge_sampler::EdgeTables;
+use crate::mesh::part::{MeshPart, PartCell};
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
+use std::sync::{Arc, OnceLock};
 
 mod crossings;
 pub mod geometry;
@@ -293,6 +296,15 @@ pub struct Scene {
     parent: Vec<Option<u32>>,
     sensor_medium: Option<u32>,
     size: f64,
+    /// Per shape, the volume it encloses (0 if open).
+    volume: Vec<f64>,
+    /// Per shape, its tables (caster, edges), built on first use and
+    /// shared with the scenes derived from this one that hold it unmoved.
+    parts: Vec<PartCell>,
+    /// The edge tables over all meshes (they do not depend on the sensor),
+    /// built on first use and shared with the scenes derived from this one
+    /// by another sensor.
+    tables: Arc<OnceLock<EdgeTables>>,
 }
 
 impl Scene {
@@ -305,7 +317,19 @@ impl Scene {
         for v in &mut shapes[k].vertices {
             *v = p.motion.apply(*v, delta);
         }
-        Scene::new(shapes, self.parameters.clone(), self.sensor)
+        self.moved(shapes, self.parameters.clone())
+    }
+
+    /// The edge tables, built by `build` if no scene sharing them has.
+    pub(crate) fn edge_tables(&self, build: impl FnOnce() -> EdgeTables) -> &EdgeTables {
+        self.tables.get_or_init(build)
+    }
+
+    /// Mesh `k`'s tables, built now if no scene sharing them has.
+    pub(crate) fn part(&self, k: usize) -> Arc<MeshPart> {
+        self.parts[k]
+            .get_or_init(|| Arc::new(MeshPart::new(&self.shapes[k])))
+            .clone()
     }
 
     /// The meshes, welded.

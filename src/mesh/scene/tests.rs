@@ -579,3 +579,104 @@ fn a_mesh_touching_itself_is_rejected() {
     // Fanned from the reflex corner: a sound triangulation.
     check(occ(pentagon, vec![[2, 3, 4], [2, 4, 0], [2, 0, 1]]), None);
 }
+
+/// A lamp, a fixed floor cube and a moving box: posing the box, or seeing
+/// the scene from another sensor, keeps the lamp's and the floor's tables
+/// (the same caster and edges, not copies), and builds the box's anew.
+#[test]
+fn a_pose_rebuilds_only_the_moved_meshes_tables() {
+    use crate::method::model::Model;
+    let s = Scene::new(
+        vec![
+            lamp(),
+            cube("floor", DVec3::new(0.0, 0.0, -2.0), 0.5, Surface::Absorber),
+            cube("box", DVec3::new(0.2, 0.1, 1.0), 0.25, Surface::Absorber),
+        ],
+        vec![
+            param("tx", "box", Motion::TranslateX),
+            param(
+                "rz",
+                "box",
+                Motion::Rotate {
+                    axis: DVec3::Z,
+                    pivot: None,
+                },
+            ),
+        ],
+        irradiance(),
+    )
+    .unwrap();
+    let same = |a: &Scene, b: &Scene, k: usize| std::sync::Arc::ptr_eq(&a.part(k), &b.part(k));
+    let posed = Model::posed(&s, &[0.1, 0.3]).unwrap();
+    assert!(same(&s, &posed, 0) && same(&s, &posed, 1));
+    assert!(!same(&s, &posed, 2));
+    // The pose with no offset is the scene itself, tables and all.
+    let still = Model::posed(&s, &[0.0, 0.0]).unwrap();
+    assert!((0..3).all(|k| same(&s, &still, k)));
+    let seen = s
+        .with_sensor(Sensor::Radiance {
+            point: DVec3::new(0.0, 0.0, 0.5),
+            direction: DVec3::Z,
+        })
+        .unwrap();
+    assert!((0..3).all(|k| same(&s, &seen, k)));
+    let displaced = s.displaced(1, 0.01).unwrap();
+    assert!(same(&s, &displaced, 0) && same(&s, &displaced, 1) && !same(&s, &displaced, 2));
+}
+
+/// A pose validated where it moved agrees with the same meshes validated
+/// whole ([`Scene::new`]): the same verdict (the box driven into the floor
+/// or the lamp, or the scene grown, or shrunk) and the same tables.
+#[test]
+fn a_pose_is_validated_as_a_new_scene() {
+    use crate::method::model::Model;
+    let s = Scene::new(
+        vec![
+            lamp(),
+            cube("floor", DVec3::new(0.0, 0.0, -2.0), 0.5, Surface::Absorber),
+            cube("box", DVec3::new(0.2, 0.1, 1.0), 0.25, Surface::Absorber),
+            fog("fog", DVec3::new(-1.5, 0.0, 0.0), 0.4),
+        ],
+        vec![
+            param("tz", "box", Motion::TranslateZ),
+            param("fx", "fog", Motion::TranslateX),
+            param("grow", "box", Motion::Scale { pivot: None }),
+        ],
+        irradiance(),
+    )
+    .unwrap();
+    let whole = |offsets: &[f64]| {
+        let params = s.parameters();
+        let owner: Vec<u32> = (0..params.len()).map(|j| s.parameter_shape(j)).collect();
+        let (shapes, params) =
+            crate::scene::pose::pose(s.shapes(), params, &owner, offsets).unwrap();
+        Scene::new(shapes, params, s.sensor())
+    };
+    let cases: [&[f64]; 7] = [
+        &[0.1, 0.0, 0.0],
+        &[-2.4, 0.0, 0.0],  // into the floor
+        &[0.0, 1.8, 0.0],   // the fog around the sensor
+        &[0.0, 1.2, 0.0],   // the fog into the box's way, not touching
+        &[0.0, -30.0, 0.0], // the scene grows
+        &[0.0, 0.0, 3.0],   // the box grows into the lamp
+        &[0.0, 0.0, -0.5],  // the box shrinks
+    ];
+    for offsets in cases {
+        let (a, b) = (Model::posed(&s, offsets), whole(offsets));
+        match (&a, &b) {
+            (Ok(a), Ok(b)) => {
+                assert_eq!(a.shapes(), b.shapes(), "{offsets:?}");
+                assert_eq!(a.size(), b.size());
+                assert_eq!(a.sensor_medium(), b.sensor_medium(), "{offsets:?}");
+                for k in 0..4 {
+                    assert_eq!(a.parent_medium(k), b.parent_medium(k));
+                    assert_eq!(a.is_solid(k), b.is_solid(k));
+                    assert_eq!(a.is_closed(k), b.is_closed(k));
+                }
+                assert_eq!(a.volume, b.volume);
+            }
+            (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{offsets:?}"),
+            _ => panic!("{offsets:?}: posed {a:?}, whole {b:?}"),
+        }
+    }
+}

@@ -24,6 +24,7 @@ use super::crossings::{Aabb, check_crossings, check_self_crossings};
 use super::geometry::{bounds, point_triangle_distance, signed_volume, winding_number};
 use super::{Medium, Motion, Parameter, Scene, Sensor, Shape, Surface};
 use crate::error::{Error, Num};
+use crate::mesh::part::part_cell;
 use crate::scene::config;
 use crate::scene::limits::{check_extent, check_pivot};
 use crate::scene::material::{Coefficients, check_material, check_thickness};
@@ -122,31 +123,122 @@ impl Scene {
                 ));
             }
         }
-        check_crossings(&shapes, size)?;
+        check_crossings(&shapes, size, None)?;
         // After `orient`, whose "encloses no volume" names a closed mesh
         // flattened onto itself more plainly than the fold it also is.
-        let volume = orient(&mut shapes, &closed)?;
-        check_self_crossings(&shapes, size)?;
+        let volume = orient(&mut shapes, &closed, None)?;
+        check_self_crossings(&shapes, size, None)?;
         let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters, size)?;
-        let sensor = check_sensor(sensor, &shapes, &closed, size)?;
-        check_optical_thickness(&shapes, size)?;
-        let (parent, sensor_medium) = nest_media(&shapes, &closed, &volume, sensor.point());
-        let solid = shapes
-            .iter()
-            .zip(&closed)
-            .map(|(s, &c)| c && s.surface.is_opaque() && !inside(s, sensor.point()))
-            .collect();
-        Ok(Scene {
+        let parts = shapes.iter().map(|_| part_cell()).collect();
+        Scene {
             shapes,
             parameters,
             parameter_shape,
             sensor,
             closed,
-            solid,
-            parent,
-            sensor_medium,
+            volume,
+            parts,
+            tables: Default::default(),
+            solid: Vec::new(),
+            parent: Vec::new(),
+            sensor_medium: None,
             size,
-        })
+        }
+        .seen_from(sensor)
+    }
+
+    /// This scene's meshes posed anew: `shapes` are its own, some moved
+    /// rigidly or scaled (the same triangles over moved vertices), with
+    /// `parameters` resolved against them. Validated as [`Scene::new`]
+    /// validates, but only where something moved: a moved mesh's own
+    /// checks, and the pairs of meshes that hold a moved one (all pairs if
+    /// the scene grew, since the touching distance grows with it). An
+    /// unmoved mesh keeps its tables ([`MeshPart`](crate::mesh::part)): its
+    /// caster and edges are not built again. Anything else (other meshes,
+    /// other triangles) is built as [`Scene::new`] builds it.
+    pub(crate) fn moved(
+        &self,
+        mut shapes: Vec<Shape>,
+        parameters: Vec<Parameter>,
+    ) -> Result<Scene, Error> {
+        let rigid = shapes.len() == self.shapes.len()
+            && shapes.iter().zip(&self.shapes).all(|(a, b)| {
+                a.name == b.name
+                    && a.triangles == b.triangles
+                    && a.vertices.len() == b.vertices.len()
+                    && a.surface == b.surface
+                    && a.medium == b.medium
+            });
+        if !rigid {
+            return Scene::new(shapes, parameters, self.sensor);
+        }
+        let moved: Vec<bool> = shapes
+            .iter()
+            .zip(&self.shapes)
+            .map(|(a, b)| a.vertices != b.vertices)
+            .collect();
+        for (k, s) in shapes.iter().enumerate() {
+            if moved[k] {
+                check_shape(k, s, false)?;
+                topology(s)?;
+            }
+        }
+        let size = scene_size(&shapes)?;
+        let only = (size <= self.size).then_some(&moved[..]);
+        check_crossings(&shapes, size, only)?;
+        let volume = orient(&mut shapes, &self.closed, Some((&moved, &self.volume)))?;
+        check_self_crossings(&shapes, size, only)?;
+        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters, size)?;
+        let parts = (0..shapes.len())
+            .map(|k| {
+                if moved[k] {
+                    part_cell()
+                } else {
+                    self.parts[k].clone()
+                }
+            })
+            .collect();
+        Scene {
+            shapes,
+            parameters,
+            parameter_shape,
+            sensor: self.sensor,
+            closed: self.closed.clone(),
+            volume,
+            parts,
+            tables: Default::default(),
+            solid: Vec::new(),
+            parent: Vec::new(),
+            sensor_medium: None,
+            size,
+        }
+        .seen_from(self.sensor)
+    }
+
+    /// The same meshes and parameters seen by `sensor`, validated as
+    /// [`Scene::new`] validates a sensor; the meshes keep their tables.
+    pub fn with_sensor(&self, sensor: Sensor) -> Result<Scene, Error> {
+        self.clone().seen_from(sensor)
+    }
+
+    /// This scene with `sensor` checked and in place, and what depends on
+    /// it: which closed meshes are solids, the media around the meshes and
+    /// the sensor. Also rejects media too thick.
+    fn seen_from(mut self, sensor: Sensor) -> Result<Scene, Error> {
+        let sensor = check_sensor(sensor, &self.shapes, &self.closed, self.size)?;
+        check_optical_thickness(&self.shapes, self.size)?;
+        let (parent, sensor_medium) =
+            nest_media(&self.shapes, &self.closed, &self.volume, sensor.point());
+        self.solid = self
+            .shapes
+            .iter()
+            .zip(&self.closed)
+            .map(|(s, &c)| c && s.surface.is_opaque() && !inside(s, sensor.point()))
+            .collect();
+        self.sensor = sensor;
+        self.parent = parent;
+        self.sensor_medium = sensor_medium;
+        Ok(self)
     }
 }
 
@@ -311,10 +403,22 @@ fn topology(s: &Shape) -> Result<bool, Error> {
 /// Turns each closed mesh outward (flips every triangle if its signed
 /// volume is negative) and returns each mesh's enclosed volume (0 for open
 /// meshes); rejects a closed mesh enclosing no volume.
-fn orient(shapes: &mut [Shape], closed: &[bool]) -> Result<Vec<f64>, Error> {
+/// With `prior` (which meshes moved, and every mesh's volume before), an
+/// unmoved mesh keeps its volume and is known to face out.
+fn orient(
+    shapes: &mut [Shape],
+    closed: &[bool],
+    prior: Option<(&[bool], &[f64])>,
+) -> Result<Vec<f64>, Error> {
     let mut volume = vec![0.0; shapes.len()];
     for (k, s) in shapes.iter_mut().enumerate() {
         if !closed[k] {
+            continue;
+        }
+        if let Some((moved, before)) = prior
+            && !moved[k]
+        {
+            volume[k] = before[k];
             continue;
         }
         let (lo, hi) = bounds(&s.vertices);
