@@ -55,7 +55,13 @@ mod imp {
 
     fn push<V: Vector>(s: &mut State, x: V) {
         if s.points.len() < s.cap {
-            let mut p = [f64::from(s.path), f64::from(*s.stack.last().unwrap_or(&0)), 0.0, 0.0, 0.0];
+            let mut p = [
+                f64::from(s.path),
+                f64::from(*s.stack.last().unwrap_or(&0)),
+                0.0,
+                0.0,
+                0.0,
+            ];
             for i in 0..V::DIM.min(3) {
                 p[2 + i] = x.dot(V::axis(i));
             }

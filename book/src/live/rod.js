@@ -207,7 +207,9 @@ function widget(box) {
       const pt = points[msg.key];
       const r = rows[msg.key];
       if (msg.error) {
+        // fd, say, cannot shorten the rod past a probe at its end.
         if (r) r.paths.textContent = msg.error;
+        for (const td of pt ? pt.cells : []) Object.assign(td, { textContent: "–", title: msg.error }).dataset.error = msg.error;
         return;
       }
       const j = JSON.parse(msg.json);
