@@ -5,9 +5,9 @@
 //! Without the feature the two calls are empty inline functions and the
 //! guard a zero-sized type without `Drop`: the native build compiles them
 //! away, and its results are the same bits. With it, a thread-local
-//! recorder that is off unless [`recorded`] runs: a run's paths then pay a
+//! recorder that is off unless `recorded` runs: a run's paths then pay a
 //! flag check per vertex and allocate nothing; only the few paths sampled
-//! inside [`recorded`] are written down.
+//! inside `recorded` are written down.
 use super::Vector;
 
 /// What [`begin`] returns: while it lives, [`vertex`] adds to its walk.
