@@ -30,6 +30,7 @@ pub mod expectation;
 pub mod intensity;
 pub mod media;
 pub mod nested;
+pub mod record;
 pub mod rendering;
 pub mod thin_media;
 pub mod tolerance;

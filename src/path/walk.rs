@@ -8,6 +8,7 @@
 //! through [`Hooks`] and adds its own terms. Book: chapter "Flatland",
 //! sections "Backward path tracing" and "Next-event estimation".
 use super::deform::{Deform, SlotSet};
+use super::record;
 use super::thin_media::collision_rate;
 use super::{Coefficients, Geometry, Hit, Lobe, MediumId, NO_PRIM, Prim, Surface, Vector, mis};
 use crate::rng::{PathRng, free_path};
@@ -373,6 +374,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
     mut beta: f64,
     mut drawn: Option<Drawn<G::V>>,
 ) -> f64 {
+    let _recorded = record::begin(ray.x);
     let Ray {
         mut x,
         mut w,
@@ -402,6 +404,7 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
                 beta *= ks / mu * (-(ke - mu) * xi).exp();
                 hooks.collision(w, xi, t_b, ke);
                 x = x + w * xi;
+                record::vertex(x);
                 hooks.visit(x);
                 let v = Vertex {
                     x,
@@ -434,12 +437,15 @@ pub fn walk<G: Geometry, H: Hooks<G>>(
         }
         let Some(h) = hit else {
             // Leaving the scene: the path's last leg, cut at the scene's size.
-            hooks.visit(x + w * (2.0 * g.size()));
+            let end = x + w * (2.0 * g.size());
+            record::vertex(end);
+            hooks.visit(end);
             return total;
         };
         hooks.arrive(w, h.t);
         let leg = Leg { x, w, medium, beta };
         x = x + w * h.t;
+        record::vertex(x);
         hooks.visit(x);
         skip = h.prim;
         let k = g.shape(h.prim);

@@ -16,7 +16,6 @@ use geosens::report::{Report, RodProbe};
 use geosens::runner::{self, BLOCK, CHUNK, RunConfig, RunResult};
 use geosens::stats::Moments;
 use glam::DVec2;
-use rand::RngExt;
 use serde_json::{Value, json};
 use std::sync::Arc;
 use wasm_bindgen::prelude::*;
@@ -249,31 +248,6 @@ pub fn flat_warp(scene: &str, rays: u32) -> Result<String, JsError> {
     Ok(json!({ "origin": [x.x, x.y], "rays": out }).to_string())
 }
 
-/// `n` rays from the sensor in directions drawn from its cosine lobe (the
-/// first segment of the paths every method samples at an irradiance
-/// sensor), from the seeded stream of `seed`: `[[x0, y0, x1, y1], …]`, the
-/// far end at the first hit or `reach` away.
-#[wasm_bindgen]
-pub fn flat_rays(scene: &str, n: u32, seed: u64, reach: f64) -> Result<Vec<f64>, JsError> {
-    use geosens::flat::geometry::{NO_SEGMENT, direction};
-    let scene = flat_scene(scene)?;
-    let (x, phi_n) = match scene.sensor() {
-        geosens::flat::Sensor::Irradiance { point, normal } => (point, normal.y.atan2(normal.x)),
-        _ => return Err(js("rays are drawn for an irradiance sensor")),
-    };
-    let mut rng = geosens::rng::stream(seed, u64::MAX);
-    let mut out = Vec::with_capacity(4 * n as usize);
-    for _ in 0..n {
-        // Cosine-weighted in flatland: sin θ uniform on [-1, 1].
-        let theta = (2.0 * rng.random::<f64>() - 1.0).asin();
-        let w = direction(phi_n + theta);
-        let t = scene.cast(x, w, NO_SEGMENT).map_or(reach, |h| h.t);
-        let end = x + t * w;
-        out.extend([x.x, x.y, end.x, end.y]);
-    }
-    Ok(out)
-}
-
 /// Quantities' names as the JSON line spells them, for a page's labels.
 #[wasm_bindgen]
 pub fn quantity_names(request: &str) -> Result<Vec<String>, JsError> {
@@ -282,4 +256,31 @@ pub fn quantity_names(request: &str) -> Result<Vec<String>, JsError> {
     Ok(prepared.estimator.map_or(Vec::new(), |e| {
         e.quantities().iter().map(Quantity::to_string).collect()
     }))
+}
+
+/// Most vertices [`sampled_paths`] keeps.
+const MOST_VERTICES: usize = 20_000;
+
+/// The first `n` paths a run of `request` (`{"flat": …, "method", "seed"}`,
+/// as for [`Run`]) samples, as the estimator walked them: they draw from
+/// the stream of the run's first chunk, so they are its paths 0 to `n − 1`
+/// ([`geosens::path::record`] writes their vertices down). `{"vertices":
+/// [path, walk, x, y, z, …], "weights": [[w per quantity] per path]}`,
+/// `walk` 0 the path from the sensor, higher the walks it nested (or a
+/// finite difference's displaced twins).
+#[wasm_bindgen]
+pub fn sampled_paths(request: &str, n: u32) -> Result<String, JsError> {
+    let request: Value = serde_json::from_str(request).map_err(js)?;
+    let seed = request.get("seed").and_then(Value::as_u64).unwrap_or(0);
+    let prepared = job_of(&request).and_then(|j| j.prepare()).map_err(js)?;
+    let est = prepared
+        .estimator
+        .ok_or_else(|| js("the exact solution samples no path"))?;
+    let mut rng = geosens::rng::stream(seed, 0);
+    let mut weights = vec![vec![0.0; est.quantities().len()]; n as usize];
+    let vertices = geosens::path::record::recorded(n, MOST_VERTICES, |i| {
+        est.sample(&mut rng, &mut weights[i as usize]);
+    });
+    let flat: Vec<f64> = vertices.into_iter().flatten().collect();
+    Ok(json!({ "vertices": flat, "weights": weights }).to_string())
 }

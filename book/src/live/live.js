@@ -140,13 +140,19 @@ export function slider(parent, { label, min, max, step, value, name }) {
 }
 
 // Plots series [{points: [[x, y], …], color, dash}] and error bars
-// [{x, y, err, color}] in the rectangle of `ctx`.
-export function plot(ctx, { x0, y0, w, h }, series, bars = [], title = "", xlabel = "") {
-  const pts = series.flatMap((s) => s.points).concat(bars.flatMap((b) => [[b.x, b.y - b.err], [b.x, b.y + b.err]]));
+// [{x, y, err, color, hollow, round, probe}] in the rectangle of `ctx`.
+// With `clip`, the y range holds the series and the bars' centres, and
+// longer error bars run out of the frame (a flagged run's bar can be 100
+// times the curve). `marker`: an x drawn as a dotted vertical line.
+// `zero`: whether the y range holds 0.
+export function plot(ctx, { x0, y0, w, h }, series, bars = [], title = "", xlabel = "", { clip = false, marker = null, zero = true } = {}) {
+  const reach = clip ? bars.map((b) => [b.x, b.y]) : bars.flatMap((b) => [[b.x, b.y - b.err], [b.x, b.y + b.err]]);
+  const pts = series.flatMap((s) => s.points).concat(reach);
   let xmin = Math.min(...pts.map((p) => p[0]));
   let xmax = Math.max(...pts.map((p) => p[0]));
-  let ymin = Math.min(0, ...pts.map((p) => p[1]).filter(Number.isFinite));
-  let ymax = Math.max(0, ...pts.map((p) => p[1]).filter(Number.isFinite));
+  const ys = pts.map((p) => p[1]).filter(Number.isFinite).concat(zero ? [0] : []);
+  let ymin = Math.min(...ys);
+  let ymax = Math.max(...ys);
   if (ymax === ymin) ymax = ymin + 1;
   if (xmax === xmin) xmax = xmin + 1;
   const pad = 0.08 * (ymax - ymin);
@@ -162,6 +168,12 @@ export function plot(ctx, { x0, y0, w, h }, series, bars = [], title = "", xlabe
   ctx.lineTo(X(xmax), Y(0));
   ctx.setLineDash([2, 3]);
   ctx.stroke();
+  if (marker !== null) {
+    ctx.beginPath();
+    ctx.moveTo(X(marker), Y(ymin));
+    ctx.lineTo(X(marker), Y(ymax));
+    ctx.stroke();
+  }
   ctx.setLineDash([]);
   ctx.fillStyle = "#444";
   ctx.font = "11px sans-serif";
@@ -169,6 +181,9 @@ export function plot(ctx, { x0, y0, w, h }, series, bars = [], title = "", xlabe
   ctx.fillText(fmt(ymax, 2), x0, Y(ymax) + 4);
   ctx.fillText(fmt(ymin, 2), x0, Y(ymin));
   ctx.fillText(xlabel, x0 + w / 2, y0 + h - 4);
+  ctx.beginPath();
+  ctx.rect(X(xmin) - 6, Y(ymax), X(xmax) - X(xmin) + 12, Y(ymin) - Y(ymax));
+  ctx.clip();
   for (const s of series) {
     ctx.strokeStyle = s.color;
     ctx.setLineDash(s.dash || []);
@@ -179,13 +194,23 @@ export function plot(ctx, { x0, y0, w, h }, series, bars = [], title = "", xlabe
   }
   ctx.setLineDash([]);
   for (const b of bars) {
+    if (!Number.isFinite(b.y)) continue;
     ctx.strokeStyle = b.color;
     ctx.fillStyle = b.color;
+    ctx.lineWidth = b.probe ? 2.5 : 1;
     ctx.beginPath();
     ctx.moveTo(X(b.x), Y(b.y - b.err));
     ctx.lineTo(X(b.x), Y(b.y + b.err));
     ctx.stroke();
-    ctx.fillRect(X(b.x) - 3, Y(b.y) - 3, 6, 6);
+    ctx.beginPath();
+    if (b.round) ctx.arc(X(b.x), Y(b.y), 3, 0, 2 * Math.PI);
+    else ctx.rect(X(b.x) - 3, Y(b.y) - 3, 6, 6);
+    if (b.hollow) {
+      ctx.fillStyle = "#fff";
+      ctx.fill();
+      ctx.lineWidth = 1.5;
+      ctx.stroke();
+    } else ctx.fill();
   }
   ctx.restore();
 }
