@@ -731,8 +731,8 @@ fn bad_fd_steps_are_rejected_with_their_name() {
         &fd_args(&["--paths", "1000", "--fd-step", "0.06"]),
         1,
         &[
-            "finite differences",
-            "rod displaced by -0.12 along parameter \"length\"",
+            "error: fd step too large: finite differences",
+            "displace the rod by -0.12 along parameter \"length\"",
             "x = 1.9",
             "try a smaller --fd-step",
         ],
@@ -742,7 +742,7 @@ fn bad_fd_steps_are_rejected_with_their_name() {
     end.extend([
         "--ks", "2.1", "--ke", "3", "--length", "2", "--x", "2", "--omega", "-1",
     ]);
-    assert_rejected(&end, 1, &["finite differences", "x = 2"]);
+    assert_rejected(&end, 1, &["invalid x = 2", "x < length for fd"]);
     for method in ["exact", "transport"] {
         let mut args = vec!["rod", "--method", method, "--fd-step", "0.01"];
         args.extend(PROBE);
