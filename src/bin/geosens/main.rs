@@ -32,7 +32,7 @@
 use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use geosens::job::{Job, SceneSource, Target};
-use geosens::report::{Header, Report};
+use geosens::report::Report;
 use geosens::rod::{Direction, Probe, Rod};
 use geosens::shard::{Shard, State};
 use geosens::{Error, Estimate, Method, Quantity, RunConfig, RunResult, run};
@@ -274,12 +274,6 @@ fn slot(q: &Quantity) -> usize {
         Quantity::Sensitivity(_) => 1,
         Quantity::Gradient(_) => 2,
     }
-}
-
-/// The exact solution as a [`RunResult`] (stderr 0, `paths` 0: nothing is
-/// sampled; `seconds` is the time of the evaluation).
-fn exact_result(rod: &Rod, probe: &Probe) -> Result<RunResult, Error> {
-    geosens::job::exact_result(&Header::Rod(geosens::report::RodProbe::of(rod, probe)))
 }
 
 mod commands;

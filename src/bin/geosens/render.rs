@@ -151,10 +151,13 @@ pub(super) fn render_command(
             &geosens::runner::quiet,
         )?;
         state.write(path)?;
-        eprintln!(
-            "wrote shard {which} ({} paths) to {}",
-            state.paths,
-            path.display()
+        eprint!(
+            "{}",
+            super::output::paragraph(&format!(
+                "wrote shard {which} ({} paths) to {}",
+                state.paths,
+                path.display()
+            ))
         );
         return Ok(());
     }
@@ -210,18 +213,21 @@ pub(super) fn finish(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let text = report.json()? + "\n";
     for w in report.warnings() {
-        eprintln!("{w}");
+        eprint!("{}", super::output::paragraph(&w));
     }
     let result = &report.result;
     let written = write_images(result, dir)?;
-    eprintln!(
-        "wrote {} files to {} ({}×{} pixels, {} paths per pixel, {:.2} s)",
-        written.len(),
-        dir.display(),
-        result.width,
-        result.height,
-        result.spp,
-        result.seconds
+    eprint!(
+        "{}",
+        super::output::paragraph(&format!(
+            "wrote {} files to {} ({}×{} pixels, {} paths per pixel, {:.2} s)",
+            written.len(),
+            dir.display(),
+            result.width,
+            result.height,
+            result.spp,
+            result.seconds
+        ))
     );
     out.write_all(text.as_bytes())?;
     Ok(())
