@@ -158,6 +158,10 @@ fn comparison_row(lead: &str, exact: &str, r: &RunResult, e: &Estimate, z: &str)
     )
 }
 
+/// One method's totals over the rod tables: sampling time, largest
+/// z-score, unreliable estimates.
+type MethodTotals = (f64, f64, usize);
+
 /// The rod tables of `geosens compare`: per rod, per probe, per quantity, a
 /// row per method that estimates it, beside the exact value; returns per
 /// method the total sampling time, the largest z-score and the number of
@@ -165,7 +169,7 @@ fn comparison_row(lead: &str, exact: &str, r: &RunResult, e: &Estimate, z: &str)
 fn rod_tables(
     cfg: &RunConfig,
     out: &mut impl Write,
-) -> Result<[(f64, f64, usize); 4], Box<dyn std::error::Error>> {
+) -> Result<[MethodTotals; 4], Box<dyn std::error::Error>> {
     let mut totals = [(0.0, 0.0f64, 0usize); 4];
     let qs = quantities();
     for (name, ks, ke) in RODS {
