@@ -23,6 +23,12 @@ pub enum Error {
     /// its file cannot be read.
     #[error("invalid scene: {0}")]
     Scene(String),
+    /// The half step of central finite differences (`--method fd`) is too
+    /// large for the problem: the problem displaced by it is invalid
+    /// (shapes that touch, a probe beyond the shortened rod's end). A
+    /// smaller step helps; the scene itself is valid.
+    #[error("fd step too large: {0}")]
+    FdStep(String),
     /// States of shards that do not make one whole run, or a file that is
     /// not a state.
     #[error("cannot merge: {0}")]

@@ -38,7 +38,8 @@ pub fn check_step(h: f64) -> Result<f64, Error> {
 }
 
 /// The error for a problem displaced by `delta` along `parameter` that is
-/// invalid: it says finite differences displaced it, by how much and along
+/// invalid: the step is too large ([`Error::FdStep`]), and the message says
+/// that finite differences displaced the problem, by how much and along
 /// what. `what` names the problem (`"scene"`, `"rod"`), `note` may add how
 /// the displacement was derived from the step.
 pub fn invalid_displacement(
@@ -54,9 +55,9 @@ pub fn invalid_displacement(
     };
     // Seven significant digits: 0.1 × 3 reads 0.3, not 0.30000000000000004.
     let delta: f64 = format!("{delta:.6e}").parse().unwrap_or(delta);
-    Error::Scene(format!(
-        "finite differences: {what} displaced by {delta:+} along parameter \
-         {parameter:?}{note} is invalid: {cause}"
+    Error::FdStep(format!(
+        "finite differences displace the {what} by {delta:+} along parameter \
+         {parameter:?}{note}, and the displaced {what} is invalid: {cause}"
     ))
 }
 

@@ -334,24 +334,19 @@ fn check_fd_step(method: Option<Method>, fd_step: Option<f64>) -> Result<(), Err
     Ok(())
 }
 
-/// `method`'s estimator on `problem` with `fd_step`. An invalid displaced
-/// scene's error (`path`: its file, if any) gets a hint.
+/// `method`'s estimator on `problem` with `fd_step`. An invalid scene's
+/// error names its file (`path`), if any; a step too large for it gets a
+/// hint.
 fn estimator_of(
     method: Method,
     problem: impl Problem,
     fd_step: Option<f64>,
     path: Option<&Path>,
 ) -> Result<Box<dyn Estimator>, Error> {
+    let file = path.map_or(String::new(), |p| format!("{}: ", p.display()));
     problem.estimator(method, fd_step).map_err(|e| match e {
-        Error::Scene(msg) => {
-            let file = path.map_or(String::new(), |p| format!("{}: ", p.display()));
-            let hint = if msg.contains("displaced by") {
-                "; try a smaller --fd-step"
-            } else {
-                ""
-            };
-            Error::Scene(format!("{file}{msg}{hint}"))
-        }
+        Error::Scene(msg) => Error::Scene(format!("{file}{msg}")),
+        Error::FdStep(msg) => Error::FdStep(format!("{file}{msg}; try a smaller --fd-step")),
         other => other,
     })
 }

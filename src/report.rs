@@ -314,19 +314,22 @@ impl Report {
             "method {}: {} paths, seed {}, {:.3} s",
             r.method, r.paths, self.seed, r.seconds
         );
+        // No `n` column: every quantity of a run has the run's paths, which
+        // the line above gives, and the table keeps within 100 characters.
+        let jumps = self.counts_jumps();
         let _ = writeln!(
             t,
-            "{:<12} {:>14} {:>11} {:>9} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
+            "{:<10} {:>13} {:>8} {:>9} {:>7} {:>9} {:>8} {:>13} {:>5}{}",
             "quantity",
             "mean",
             "stderr",
-            "n",
             "nonzero",
             "vov",
             "max_share",
             "reliable",
             "exact",
-            "z"
+            "z",
+            jumps_cell(jumps, || "jumps".to_owned())
         );
         let exact = rod_exact(&rod, &probe);
         let qs = rod_quantities();
@@ -338,11 +341,10 @@ impl Report {
             let mc = e.n > 0;
             let _ = writeln!(
                 t,
-                "{:<12} {:>14.6e} {:>11.2e} {:>9} {:>9} {:>9} {:>9} {:>8} {:>14} {:>6}",
+                "{:<10} {:>13.6e} {:>8.2e} {:>9} {:>7} {:>9} {:>8} {:>13} {:>5}{}",
                 q.to_string(),
                 e.mean,
                 e.stderr,
-                e.n,
                 dash(mc, || e.nonzero.to_string()),
                 dash(mc, || format!("{:.1e}", e.vov)),
                 dash(mc, || format!("{:.1e}", e.max_share)),
@@ -350,9 +352,16 @@ impl Report {
                     .to_owned()),
                 dash(mc, || format!("{ex:.6e}")),
                 dash(mc, || z_text(e, ex)),
+                jumps_cell(jumps, || jumps_text(e)),
             );
         }
         Ok(t)
+    }
+
+    /// Whether an estimate of the run counts its jumps (a central
+    /// difference's derivatives): its table then has a `jumps` column.
+    fn counts_jumps(&self) -> bool {
+        self.result.estimates.iter().any(|(_, e)| e.jumps.is_some())
     }
 
     fn scene_table(&self, scene: &str, shapes: usize, parameters: usize) -> String {
@@ -364,27 +373,52 @@ impl Report {
             "method {}: {} paths, seed {}, {:.3} s",
             r.method, r.paths, self.seed, r.seconds
         );
+        let jumps = self.counts_jumps();
         let _ = writeln!(
             t,
-            "{:<20} {:>14} {:>11} {:>9} {:>9} {:>9} {:>8}",
-            "quantity", "mean", "stderr", "nonzero", "vov", "max_share", "reliable"
+            "{:<20} {:>14} {:>11} {:>9} {:>9} {:>9} {:>8}{}",
+            "quantity",
+            "mean",
+            "stderr",
+            "nonzero",
+            "vov",
+            "max_share",
+            "reliable",
+            jumps_cell(jumps, || "jumps".to_owned())
         );
         for (q, e) in &r.estimates {
             let caveat = caveat_of(&self.caveats, q);
             let _ = writeln!(
                 t,
-                "{:<20} {:>14.6e} {:>11.2e} {:>9} {:>9.1e} {:>9.1e} {:>8}",
+                "{:<20} {:>14.6e} {:>11.2e} {:>9} {:>9.1e} {:>9.1e} {:>8}{}",
                 q.to_string(),
                 e.mean,
                 e.stderr,
                 e.nonzero,
                 e.vov,
                 e.max_share,
-                reliable_text(e, caveat)
+                reliable_text(e, caveat),
+                jumps_cell(jumps, || jumps_text(e))
             );
         }
         t
     }
+}
+
+/// The `jumps` cell, with its leading space, where the table has the
+/// column (`shown`), else nothing.
+fn jumps_cell(shown: bool, text: impl FnOnce() -> String) -> String {
+    if shown {
+        format!(" {:>7}", text())
+    } else {
+        String::new()
+    }
+}
+
+/// An estimate's jumps ([`Estimate::jumps`]), `-` where not counted (a
+/// central difference's `I`, which is no difference).
+fn jumps_text(e: &Estimate) -> String {
+    e.jumps.map_or("-".to_owned(), |k| k.to_string())
 }
 
 /// `text()` if `show`, else `-`.

@@ -318,17 +318,20 @@ fn compare_runs() {
     for word in ["thin rod", "thick rod", "exact", "transport", "reliable"] {
         assert!(text.contains(word), "missing {word:?}");
     }
+    // A terminal or a log shows every line unbroken (`tests/cli_width.rs`).
+    for line in text.lines().chain(stderr.lines()) {
+        assert!(
+            line.chars().count() <= 100,
+            "{} characters: {line}",
+            line.chars().count()
+        );
+    }
     // Every number of the table against the library: the same scenes, the
     // same seed and path count (on one thread: results do not depend on it).
     let cfg = RunConfig::new(2000, 1).unwrap().threads(1);
-    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty()).peekable();
     let totals = assert_rod_tables(&mut lines, &cfg);
-    assert!(
-        lines
-            .next()
-            .unwrap()
-            .starts_with("per method over the 16 probes")
-    );
+    assert!(title(&mut lines).starts_with("per method over the 16 probes"));
     lines.next(); // column titles
     for (m, (z, bad)) in Method::UNBIASED.iter().zip(totals) {
         let line = lines.next().unwrap();
@@ -339,12 +342,17 @@ fn compare_runs() {
     }
     assert_mesh_tables(&mut lines, &cfg);
     // The short comparison by time to the answer: a row per method.
-    assert!(lines.next().unwrap().starts_with("optimisation: "));
-    assert!(lines.next().unwrap().starts_with("problem"));
+    let optimisation = title(&mut lines);
+    assert!(optimisation.starts_with("optimisation: "), "{optimisation}");
+    assert!(
+        optimisation.contains("(inverse_occluder.toml)"),
+        "{optimisation}"
+    );
+    assert!(lines.next().unwrap().starts_with("method"));
     for m in ["expectation", "rendering", "transport", "fd"] {
         let line = lines.next().unwrap();
         let t: Vec<&str> = line.split_whitespace().collect();
-        assert_eq!(t[..2], ["inverse_occluder", m], "{line}");
+        assert_eq!(t[0], m, "{line}");
         assert!(line.contains("/3"), "{line}");
     }
     assert!(lines.next().unwrap().starts_with("total wall time"));
@@ -354,20 +362,56 @@ fn compare_runs() {
     assert_rejected(&["compare", "--effort", "nan"], 1, &["effort = NaN"]);
 }
 
+/// The next title or note of `lines`, its wrapped lines (indented by two
+/// spaces) joined by spaces.
+fn title<'a>(lines: &mut Peekable<impl Iterator<Item = &'a str>>) -> String {
+    let mut text = lines.next().expect("a title").to_owned();
+    while let Some(more) = lines.next_if(|l| l.starts_with("  ") && !l.starts_with("   ")) {
+        text.push(' ');
+        text.push_str(more.trim_start());
+    }
+    text
+}
+
+/// Asserts one row of `geosens compare`'s tables after its leading columns
+/// (`tokens`): the method, its estimate `e` (`mean ± stderr z score`, the
+/// score `z`), whether it is reliable, the time.
+fn assert_row<'a>(
+    tokens: &mut impl Iterator<Item = &'a str>,
+    method: &str,
+    e: &Estimate,
+    z: f64,
+    what: &str,
+) {
+    let t: Vec<&str> = tokens.collect();
+    assert_eq!(t.len(), 8, "{what}: {t:?}");
+    assert_eq!((t[0], t[2], t[4]), (method, "±", "z"), "{what}: {t:?}");
+    assert_printed(t[1], e.mean, &format!("{what}: mean"));
+    assert_printed(t[3], e.stderr, &format!("{what}: stderr"));
+    if z.is_finite() {
+        assert_printed(t[5], z, &format!("{what}: z"));
+    } else {
+        assert_eq!(t[5], "-", "{what}: z of {e:?}");
+    }
+    let reliable = if e.is_reliable() { "yes" } else { "no" };
+    assert_eq!(t[6], reliable, "{what}: {e:?}");
+    assert!(t[7].parse::<f64>().is_ok(), "{what}: time {}", t[7]);
+}
+
 /// Asserts the rod tables of `geosens compare` (the next of `lines`) print
 /// the exact solution and the library's runs with `cfg` on the thin and
 /// thick rods; returns each method's largest z-score and number of
 /// unreliable estimates, for the summary.
 fn assert_rod_tables<'a>(
-    lines: &mut impl Iterator<Item = &'a str>,
+    lines: &mut Peekable<impl Iterator<Item = &'a str>>,
     cfg: &RunConfig,
 ) -> [(f64, usize); 4] {
     let quantities = geosens::report::rod_quantities();
     let mut totals = [(0.0f64, 0usize); 4];
     for (name, ks, ke) in [("thin", 0.07, 0.1), ("thick", 2.1, 3.0)] {
-        let header = lines.next().unwrap();
+        let header = title(lines);
         assert!(header.starts_with(&format!("{name} rod: ")), "{header}");
-        assert_eq!(runs_of(header), (cfg.paths, cfg.seed), "{header}");
+        assert_eq!(runs_of(&header), (cfg.paths, cfg.seed), "{header}");
         lines.next(); // column titles
         let rod = Rod::new(ks, ke, 2.0).unwrap();
         for x in [0.0, 1.0, 1.9, 2.0] {
@@ -375,40 +419,41 @@ fn assert_rod_tables<'a>(
                 let exact = exact::solve(&rod, x, omega);
                 let exact = [exact.intensity, exact.sensitivity, exact.gradient_x];
                 let label = format!("{x}, {:+}", omega.sign());
-                let what = format!("{name} rod at {label}");
-                let line = lines.next().unwrap();
-                let mut tokens = line.split_whitespace().peekable();
-                let first: Vec<&str> = tokens.by_ref().take(3).collect();
-                assert_eq!(first.join(" "), format!("{label} exact"), "{line}");
-                for (cell, value) in cells(&mut tokens, 3).iter().zip(exact) {
-                    let Cell::Value(v) = cell else {
-                        panic!("{what}: exact {cell:?}")
-                    };
-                    assert_printed(v, value, &format!("{what}: exact"));
-                }
-                assert_eq!(tokens.next(), Some("-"), "{what}: {line}");
                 let probe = Probe::new(&rod, x, omega).unwrap();
-                for (m, total) in Method::UNBIASED.iter().zip(&mut totals) {
-                    let r = run(m.estimator((rod, probe)).unwrap().as_ref(), cfg).unwrap();
-                    assert_eq!(r.paths, cfg.paths);
-                    let what = format!("{what}, {}", m.name());
-                    let line = lines.next().unwrap();
-                    let mut tokens = line.split_whitespace().peekable();
-                    assert_eq!(tokens.next(), Some(m.name()), "{what}: {line}");
-                    let printed = cells(&mut tokens, 3);
-                    for ((cell, q), exact) in printed.iter().zip(&quantities).zip(exact) {
-                        let Some(e) = r.get(q) else {
-                            assert_eq!(*cell, Cell::Absent, "{what} {q}");
-                            continue;
-                        };
+                let runs: Vec<RunResult> = Method::UNBIASED
+                    .iter()
+                    .map(|m| run(m.estimator((rod, probe)).unwrap().as_ref(), cfg).unwrap())
+                    .collect();
+                let mut first_of_probe = true;
+                for (q, exact) in quantities.iter().zip(exact) {
+                    let mut first = true;
+                    for r in &runs {
+                        let Some(e) = r.get(q) else { continue };
+                        let what = format!("{name} rod at {label}, {q} by {}", r.method);
+                        let line = lines.next().unwrap();
+                        let mut tokens = line.split_whitespace();
+                        if first_of_probe {
+                            let probe: Vec<&str> = tokens.by_ref().take(2).collect();
+                            assert_eq!(probe.join(" "), label, "{what}: {line}");
+                            first_of_probe = false;
+                        }
+                        if first {
+                            assert_eq!(tokens.next(), Some(q.to_string().as_str()), "{line}");
+                            let printed = tokens.next().unwrap();
+                            assert_printed(printed, exact, &format!("{what}: exact"));
+                            first = false;
+                        }
                         let z = e.z_score(exact);
-                        assert_estimate(cell, &e, z, &format!("{what} {q}"));
-                        total.0 = total.0.max(z);
+                        assert_row(&mut tokens, r.method, &e, z, &what);
+                    }
+                }
+                for (r, total) in runs.iter().zip(&mut totals) {
+                    assert_eq!(r.paths, cfg.paths);
+                    for (q, e) in &r.estimates {
+                        let k = quantities.iter().position(|p| p == q).unwrap();
+                        total.0 = total.0.max(e.z_score(exact[k]));
                         total.1 += usize::from(!e.is_reliable());
                     }
-                    let reliable = r.estimates.iter().all(|(_, e)| e.is_reliable());
-                    let word = if reliable { "yes" } else { "no" };
-                    assert_eq!(tokens.next(), Some(word), "{what}: {line}");
                 }
             }
         }
@@ -418,12 +463,12 @@ fn assert_rod_tables<'a>(
 
 /// Asserts the 3D tables of `geosens compare` (the next of `lines`) print
 /// the closed forms and the library's runs with `cfg` of every method.
-fn assert_mesh_tables<'a>(lines: &mut impl Iterator<Item = &'a str>, cfg: &RunConfig) {
+fn assert_mesh_tables<'a>(lines: &mut Peekable<impl Iterator<Item = &'a str>>, cfg: &RunConfig) {
     for (what, scene, e, s) in mesh_scenes() {
-        let header = lines.next().unwrap();
+        let header = title(lines);
         assert!(header.starts_with(&format!("3D: {what}")), "{header}");
-        assert_eq!(runs_of(header), (cfg.paths, cfg.seed), "{header}");
-        lines.next(); // column titles
+        assert_eq!(runs_of(&header), (cfg.paths, cfg.seed), "{header}");
+        assert!(lines.next().unwrap().contains("reliable"));
         let scene = Arc::new(scene);
         let runs: Vec<RunResult> = Method::ALL
             .iter()
@@ -440,21 +485,20 @@ fn assert_mesh_tables<'a>(lines: &mut impl Iterator<Item = &'a str>, cfg: &RunCo
                 assert_eq!(r.paths, cfg.paths);
                 let what = format!("3D {what}: {label} by {}", r.method);
                 let line = lines.next().unwrap();
-                let mut tokens = line.split_whitespace().peekable();
+                let mut tokens = line.split_whitespace();
                 if first {
                     assert_eq!(tokens.next(), Some(label.as_str()), "{what}: {line}");
                     let closed = tokens.next().unwrap();
                     assert_printed(closed, *exact, &format!("{what}: closed form"));
                     first = false;
                 }
-                assert_eq!(tokens.next(), Some(r.method), "{what}: {line}");
                 // Signed, and 0 where the estimate is the closed form.
                 let z = if est.mean == *exact {
                     0.0
                 } else {
                     (est.mean - exact) / est.stderr
                 };
-                assert_estimate(&cells(&mut tokens, 1)[0], &est, z, &what);
+                assert_row(&mut tokens, r.method, &est, z, &what);
             }
         }
     }
@@ -466,69 +510,6 @@ fn runs_of(header: &str) -> (u64, u64) {
     let t: Vec<&str> = tail.split_whitespace().collect();
     assert_eq!(t[1..5], ["paths", "per", "run,", "seed"], "{header}");
     (t[0].parse().unwrap(), t[5].parse().unwrap())
-}
-
-/// One cell of `geosens compare`'s tables, as printed.
-#[derive(Debug, PartialEq)]
-enum Cell<'a> {
-    /// `-`: the method does not estimate the quantity.
-    Absent,
-    /// A bare value: an exact row's.
-    Value(&'a str),
-    /// `mean ± stderr z score`, the score followed by `!` if the error bar
-    /// is flagged unreliable.
-    Estimate {
-        mean: &'a str,
-        stderr: &'a str,
-        z: &'a str,
-        unreliable: bool,
-    },
-}
-
-/// The next `n` cells of a row's `tokens`.
-fn cells<'a>(tokens: &mut Peekable<impl Iterator<Item = &'a str>>, n: usize) -> Vec<Cell<'a>> {
-    (0..n)
-        .map(|_| {
-            let first = tokens.next().expect("a cell");
-            if first == "-" {
-                return Cell::Absent;
-            }
-            if tokens.next_if_eq(&"±").is_none() {
-                return Cell::Value(first);
-            }
-            let stderr = tokens.next().expect("a standard error");
-            assert_eq!(tokens.next(), Some("z"));
-            let z = tokens.next().expect("a z-score");
-            Cell::Estimate {
-                mean: first,
-                stderr,
-                z: z.trim_end_matches('!'),
-                unreliable: z.ends_with('!'),
-            }
-        })
-        .collect()
-}
-
-/// Asserts `cell` prints `e`: its mean, standard error and z-score `z` to
-/// the digits printed, and its reliability flag.
-fn assert_estimate(cell: &Cell, e: &Estimate, z: f64, what: &str) {
-    let Cell::Estimate {
-        mean,
-        stderr,
-        z: score,
-        unreliable,
-    } = cell
-    else {
-        panic!("{what}: {cell:?} for {e:?}")
-    };
-    assert_printed(mean, e.mean, &format!("{what}: mean"));
-    assert_printed(stderr, e.stderr, &format!("{what}: stderr"));
-    if z.is_finite() {
-        assert_printed(score, z, &format!("{what}: z"));
-    } else {
-        assert_eq!(*score, "-", "{what}: z of {e:?}");
-    }
-    assert_eq!(*unreliable, !e.is_reliable(), "{what}: {e:?}");
 }
 
 /// Asserts the printed `token` is `value` to the digits printed: within half
@@ -605,11 +586,28 @@ fn compare_writes_the_figures() {
         "--figures",
         dir_arg,
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(out.status.success(), "{stderr}");
+    // Its stderr not a terminal, compare draws no bar but writes a line per
+    // picture: its path and the seconds its figure took.
+    let mut pictures = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension() != Some("png".as_ref()) {
+            continue;
+        }
+        pictures += 1;
+        let head = format!("wrote {} (", path.display());
+        let line = stderr.lines().find(|l| l.starts_with(&head));
+        let seconds = line.and_then(|l| l[head.len()..].strip_suffix(" s)"));
+        assert!(
+            seconds.is_some_and(|s| s.parse::<f64>().is_ok()),
+            "no line for {}: {stderr}",
+            path.display()
+        );
+    }
+    let logged = stderr.lines().filter(|l| l.starts_with("wrote ")).count();
+    assert_eq!(logged, pictures, "{stderr}");
     // Figures drawn in several pictures keep their numbers in one JSON.
     for (name, pictures) in [
         (
@@ -731,8 +729,8 @@ fn bad_fd_steps_are_rejected_with_their_name() {
         &fd_args(&["--paths", "1000", "--fd-step", "0.06"]),
         1,
         &[
-            "finite differences",
-            "rod displaced by -0.12 along parameter \"length\"",
+            "error: fd step too large: finite differences",
+            "displace the rod by -0.12 along parameter \"length\"",
             "x = 1.9",
             "try a smaller --fd-step",
         ],
@@ -742,7 +740,7 @@ fn bad_fd_steps_are_rejected_with_their_name() {
     end.extend([
         "--ks", "2.1", "--ke", "3", "--length", "2", "--x", "2", "--omega", "-1",
     ]);
-    assert_rejected(&end, 1, &["finite differences", "x = 2"]);
+    assert_rejected(&end, 1, &["invalid x = 2", "x < length for fd"]);
     for method in ["exact", "transport"] {
         let mut args = vec!["rod", "--method", method, "--fd-step", "0.01"];
         args.extend(PROBE);

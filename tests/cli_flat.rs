@@ -263,8 +263,9 @@ fn an_invalid_displaced_scene_names_the_file_the_parameter_and_finite_difference
         &["--method", "fd", "--paths", "1000", "--fd-step", "0.1"],
         &[
             "three_shapes.toml",
+            "fd step too large",
             "finite differences",
-            "displaced by +0.3 along parameter \"block_tx\"",
+            "displace the scene by +0.3 along parameter \"block_tx\"",
             "shapes \"block\" and \"fog\" touch or cross",
             "try a smaller --fd-step",
         ],

@@ -37,6 +37,10 @@ pub struct FigureOptions {
     pub effort: f64,
     /// Show a progress bar.
     pub progress: bool,
+    /// Print a line per picture written on stderr, its path and the
+    /// seconds its figure took: where no progress bar is drawn (stderr not
+    /// a terminal), a log shows how far the figures have got.
+    pub log: bool,
 }
 
 impl FigureOptions {
@@ -48,6 +52,7 @@ impl FigureOptions {
             threads: 0,
             effort: 1.0,
             progress: true,
+            log: false,
         }
     }
 
@@ -146,7 +151,18 @@ pub const REFERENCE_COLOR: usize = 6;
 pub(crate) fn all(opts: &FigureOptions, figures: &[FigureFn]) -> Result<Vec<PathBuf>, Error> {
     let mut written = Vec::new();
     for figure in figures {
-        written.extend(figure(opts)?);
+        let start = crate::runner::Stopwatch::start();
+        let files = figure(opts)?;
+        if opts.log {
+            let seconds = start.seconds();
+            let pictures = files
+                .iter()
+                .filter(|f| f.extension() == Some("png".as_ref()));
+            for picture in pictures {
+                eprintln!("wrote {} ({seconds:.1} s)", picture.display());
+            }
+        }
+        written.extend(files);
     }
     Ok(written)
 }

@@ -246,11 +246,12 @@ fn check_collisions(rod: &Rod) -> Result<(), Error> {
 /// ([`thin_medium_caveat`](crate::fd::thin_medium_caveat)).
 pub fn finite_difference(rod: Rod, probe: Probe, step: f64) -> Result<CentralDifference, Error> {
     if probe.x >= rod.length {
-        return Err(Error::Scene(format!(
-            "finite differences in the length need the probe inside the rod \
-             (x < length): at x = {} no shortened rod contains it",
-            crate::error::Num(probe.x)
-        )));
+        return Err(Error::InvalidParameter {
+            name: "x",
+            value: probe.x,
+            expected: "x < length for fd: finite differences in the length shorten the rod, \
+                       and no shortened rod contains its end (the other methods take x = length)",
+        });
     }
     let h = step * rod.length;
     let displaced = |delta: f64| -> Result<Box<dyn Estimator>, Error> {

@@ -1,6 +1,6 @@
 //! The subcommands: `rod`, `compare` and `flat`, each printing a table or
 //! one JSON line.
-use super::output::{progress_bar, shown};
+use super::output::{paragraph, progress_bar, shown};
 use super::*;
 use geosens::report::{RodProbe, yes_no, z_text};
 use geosens::shard::Merged;
@@ -66,12 +66,15 @@ fn estimate(
     bar.finish_and_clear();
     let state = state?;
     state.write(path)?;
-    eprintln!(
-        "wrote shard {which} ({} of {} paths, {:.2} s) to {}",
-        state.paths,
-        state.run.paths,
-        state.seconds,
-        path.display()
+    eprint!(
+        "{}",
+        paragraph(&format!(
+            "wrote shard {which} ({} of {} paths, {:.2} s) to {}",
+            state.paths,
+            state.run.paths,
+            state.seconds,
+            path.display()
+        ))
     );
     Ok(())
 }
@@ -88,7 +91,7 @@ fn print_report(
         report.table()?
     };
     for w in report.warnings() {
-        eprintln!("{w}");
+        eprint!("{}", super::output::paragraph(&w));
     }
     out.write_all(text.as_bytes())?;
     Ok(())
@@ -136,42 +139,85 @@ const RODS: [(&str, f64, f64); 2] = [("thin", 0.07, 0.1), ("thick", 2.1, 3.0)];
 /// Probe positions of the comparison.
 const XS: [f64; 4] = [0.0, 1.0, 1.9, 2.0];
 
-/// Width of one quantity cell of the comparison table.
-const CELL: usize = 32;
-
-/// One comparison cell: `mean ± stderr z`, a `!` if the error bar is
-/// unreliable, the bare value for an exact estimate (`n = 0`), `-` if absent.
-fn cell(e: Option<Estimate>, exact: f64) -> String {
-    match e {
-        None => format!("{:>10}", "-"),
-        Some(e) if e.n == 0 => format!("{:>10.6}", e.mean),
-        Some(e) => format!(
-            "{:>10.6} ± {:<7.1e} z {:>4}{}",
-            e.mean,
-            e.stderr,
-            z_text(&e, exact),
-            if e.is_reliable() { "" } else { "!" }
-        ),
-    }
+/// `mean ± stderr z score`: the estimate column of the comparison tables,
+/// `z` printed as given.
+fn estimate_cell(e: &Estimate, z: &str) -> String {
+    format!("{:>11.6} ± {:<7.1e} z {z:>5}", e.mean, e.stderr)
 }
 
-/// One row of the comparison table: probe label, method, one cell per
-/// quantity, reliability of the whole row, sampling time.
-fn row(label: &str, r: &RunResult, exact: &[f64; 3]) -> String {
-    let qs = quantities();
-    let cells: Vec<String> = qs
-        .iter()
-        .zip(exact)
-        .map(|(q, &x)| format!("{:<CELL$}", cell(r.get(q), x)))
-        .collect();
-    let reliable = r.estimates.iter().all(|(_, e)| e.is_reliable());
+/// The columns of the comparison tables after the rod's probe (or the 3D
+/// table's quantity): the reference value, the method, its estimate,
+/// whether the error bar can be trusted, the run's time.
+fn comparison_row(lead: &str, exact: &str, r: &RunResult, e: &Estimate, z: &str) -> String {
     format!(
-        "{label:<10} {:<12} {} {:>8} {:>9.3}",
+        "{lead} {exact:>11} {:<11} {:<29} {:>8} {:>9.3}",
         r.method,
-        cells.join(" "),
-        if r.paths == 0 { "-" } else { yes_no(reliable) },
+        estimate_cell(e, z),
+        yes_no(e.is_reliable()),
         r.seconds
     )
+}
+
+/// One method's totals over the rod tables: sampling time, largest
+/// z-score, unreliable estimates.
+type MethodTotals = (f64, f64, usize);
+
+/// The rod tables of `geosens compare`: per rod, per probe, per quantity, a
+/// row per method that estimates it, beside the exact value; returns per
+/// method the total sampling time, the largest z-score and the number of
+/// unreliable estimates.
+fn rod_tables(
+    cfg: &RunConfig,
+    out: &mut impl Write,
+) -> Result<[MethodTotals; 4], Box<dyn std::error::Error>> {
+    let mut totals = [(0.0, 0.0f64, 0usize); 4];
+    let qs = quantities();
+    for (name, ks, ke) in RODS {
+        let rod = Rod::new(ks, ke, 2.0)?;
+        write!(
+            out,
+            "\n{}",
+            paragraph(&format!(
+                "{name} rod: κs = {ks}, κe = {ke}, length 2; {} paths per run, seed {}",
+                cfg.paths, cfg.seed
+            ))
+        )?;
+        writeln!(
+            out,
+            "{:<7} {:<10} {:>11} {:<11} {:<29} {:>8} {:>9}",
+            "x, ω", "quantity", "exact", "method", "estimate", "reliable", "time [s]"
+        )?;
+        for x in XS {
+            for omega in [Direction::Right, Direction::Left] {
+                let probe = Probe::new(&rod, x, omega)?;
+                let ex = geosens::report::rod_exact(&rod, &probe);
+                let mut runs = Vec::with_capacity(Method::UNBIASED.len());
+                for m in Method::UNBIASED {
+                    runs.push(run(m.estimator((rod, probe))?.as_ref(), cfg)?);
+                }
+                let mut label = format!("{x}, {:+}", omega.sign());
+                for (q, exact) in qs.iter().zip(ex) {
+                    let mut quantity = q.to_string();
+                    let mut reference = format!("{exact:>11.6}");
+                    for r in &runs {
+                        let Some(e) = r.get(q) else { continue };
+                        let lead = format!("{label:<7} {quantity:<10}");
+                        let row = comparison_row(&lead, &reference, r, &e, &z_text(&e, exact));
+                        writeln!(out, "{row}")?;
+                        (label, quantity, reference) = Default::default();
+                    }
+                }
+                for (r, total) in runs.iter().zip(&mut totals) {
+                    total.0 += r.seconds;
+                    for (q, e) in &r.estimates {
+                        total.1 = total.1.max(e.z_score(ex[slot(q)]));
+                        total.2 += usize::from(!e.is_reliable());
+                    }
+                }
+            }
+        }
+    }
+    Ok(totals)
 }
 
 /// `geosens compare`.
@@ -193,46 +239,19 @@ pub(super) fn compare_command(
         super::output::writable_dir(&args.figures)?;
     }
     let start = Instant::now();
-    // Per method: total sampling time, largest z-score, unreliable estimates.
-    let mut totals = [(0.0, 0.0f64, 0usize); 4];
-    for (name, ks, ke) in RODS {
-        let rod = Rod::new(ks, ke, 2.0)?;
-        writeln!(
-            out,
-            "\n{name} rod: κs = {ks}, κe = {ke}, length 2; {} paths per run, seed {}",
-            cfg.paths, cfg.seed
-        )?;
-        writeln!(
-            out,
-            "{:<10} {:<12} {:<CELL$} {:<CELL$} {:<CELL$} {:>8} {:>9}",
-            "x, ω", "method", "I", "∂I/∂length", "∂I/∂x", "reliable", "time [s]"
-        )?;
-        for x in XS {
-            for omega in [Direction::Right, Direction::Left] {
-                let probe = Probe::new(&rod, x, omega)?;
-                let ex = geosens::report::rod_exact(&rod, &probe);
-                let label = format!("{x}, {:+}", omega.sign());
-                writeln!(out, "{}", row(&label, &exact_result(&rod, &probe)?, &ex))?;
-                for (m, total) in Method::UNBIASED.iter().zip(&mut totals) {
-                    let r = run(m.estimator((rod, probe))?.as_ref(), &cfg)?;
-                    writeln!(out, "{}", row("", &r, &ex))?;
-                    total.0 += r.seconds;
-                    for (q, e) in &r.estimates {
-                        total.1 = total.1.max(e.z_score(ex[slot(q)]));
-                        total.2 += usize::from(!e.is_reliable());
-                    }
-                }
-            }
-        }
-    }
-    writeln!(
+    let totals = rod_tables(&cfg, out)?;
+    write!(
         out,
-        "\nper method over the 16 probes (z: distance to exact in stderrs; \
-         !: error bar unreliable: VOV ≥ {}, fewer than {} non-zero weights (for fd, also \
-         fewer than {} jumps), or not finite)",
-        Estimate::VOV_LIMIT,
-        Estimate::MIN_NONZERO,
-        Estimate::MIN_NONZERO
+        "\n{}",
+        paragraph(&format!(
+            "per method over the 16 probes (z: distance to the exact value in standard \
+             errors; reliable: no where the error bar cannot be trusted: VOV ≥ {}, fewer \
+             than {} non-zero weights (for fd, also fewer than {} jumps or more than half \
+             the pairs), or not finite)",
+            Estimate::VOV_LIMIT,
+            Estimate::MIN_NONZERO,
+            Estimate::MIN_NONZERO
+        ))
     )?;
     writeln!(
         out,
@@ -259,6 +278,8 @@ pub(super) fn compare_command(
         opts.threads = cfg.threads;
         opts.effort = effort;
         opts.progress = io::stderr().is_terminal();
+        // Without a bar, a line per picture: a log shows how far it got.
+        opts.log = !opts.progress;
         let start = Instant::now();
         let mut written = figures::all(&opts)?;
         written.extend(geosens::flat::figures::all(&opts)?);
@@ -306,16 +327,20 @@ fn optimisation_table(
     let loaded = Loaded::flat_toml(compare::INVERSE_OCCLUDER)?;
     let truth = compare::PROBLEMS[0].truth.unwrap_or(&[0.12, 0.2]);
     let budget = OPTIMISATION_BUDGET;
-    writeln!(
+    write!(
         out,
-        "\noptimisation: the flatland inverse problem (inverse_occluder.toml), Adam, \
-         {} iterations of {} paths per measurement, seeds {} to {}; time to tolerance: \
-         until the tail average's error (translation / size, rotation in rad) falls under \
-         {TOLERANCE:e} and stays there (examples/optimize_compare for the full table)",
-        budget.iterations,
-        budget.paths,
-        cfg.seed,
-        cfg.seed + OPTIMISATION_SEEDS - 1
+        "\n{}",
+        paragraph(&format!(
+            "optimisation: the flatland inverse problem (inverse_occluder.toml), Adam, \
+             {} iterations of {} paths per measurement, seeds {} to {}, medians (min–max) \
+             over the seeds; time to tolerance: until the tail average's error (translation \
+             / size, rotation in rad) falls under {TOLERANCE:e} and stays there \
+             (examples/optimize_compare for the full table)",
+            budget.iterations,
+            budget.paths,
+            cfg.seed,
+            cfg.seed + OPTIMISATION_SEEDS - 1
+        ))
     )?;
     let mut rows = Vec::new();
     for method in [
@@ -345,28 +370,57 @@ fn optimisation_table(
         bar.finish_and_clear();
         rows.push(compare::row("inverse_occluder", &runs?));
     }
-    writeln!(out, "{}", compare::text_table(&rows))?;
+    write!(out, "{}", optimisation_text(&rows))?;
     Ok(())
 }
 
-/// One cell of the 3D table: `mean ± stderr z` with the signed z-score
-/// against the closed form, `!` if the error bar is unreliable.
-fn mesh_cell(e: &Estimate, exact: f64) -> String {
+/// The optimisation rows as a table without their problem column (the
+/// title names the one problem), columns padded, within 100 characters.
+fn optimisation_text(rows: &[geosens::optimize::compare::Row]) -> String {
+    const COLUMNS: [&str; 6] = [
+        "method",
+        "to tol. [s] (min–max)",
+        "paths to tol.",
+        "reached",
+        "final error (min–max)",
+        "run [s]",
+    ];
+    let cells: Vec<Vec<String>> = rows.iter().map(|r| r.cells()[1..].to_vec()).collect();
+    let width = |c: usize| {
+        cells
+            .iter()
+            .map(|r| r[c].chars().count())
+            .chain([COLUMNS[c].chars().count()])
+            .max()
+            .unwrap_or(0)
+    };
+    let widths: Vec<usize> = (0..COLUMNS.len()).map(width).collect();
+    let line = |r: &[&str]| {
+        let padded: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .map(|(c, &w)| format!("{c:<w$}"))
+            .collect();
+        padded.join("  ").trim_end().to_owned() + "\n"
+    };
+    let mut text = line(&COLUMNS);
+    for r in &cells {
+        text += &line(&r.iter().map(String::as_str).collect::<Vec<_>>());
+    }
+    text
+}
+
+/// The signed z-score of `e` against `exact` as the 3D table prints it:
+/// `0.0` where the estimate is the closed form, `-` where no z is finite.
+fn signed_z(e: &Estimate, exact: f64) -> String {
     let z = (e.mean - exact) / e.stderr;
-    let z = if e.mean == exact {
+    if e.mean == exact {
         "0.0".to_owned()
     } else if z.is_finite() {
         format!("{z:+.1}")
     } else {
         "-".to_owned()
-    };
-    format!(
-        "{:>11.6} ± {:<7.1e} z {:>5}{}",
-        e.mean,
-        e.stderr,
-        z,
-        if e.is_reliable() { "" } else { "!" }
-    )
+    }
 }
 
 /// The 3D rows of `geosens compare`: every method on two occluder scenes
@@ -407,16 +461,19 @@ fn mesh_table(cfg: &RunConfig, out: &mut impl Write) -> Result<(), Box<dyn std::
     );
     for (what, scene, e, s) in [triangle, boxed] {
         let scene = std::sync::Arc::new(scene);
-        writeln!(
+        write!(
             out,
-            "\n3D: {what} at z ≈ 1 under the unit-square lamp (radiance 1) at z = 2, \
-             irradiance at the origin (normal +z); {} paths per run, seed {}",
-            cfg.paths, cfg.seed
+            "\n{}",
+            paragraph(&format!(
+                "3D: {what} at z ≈ 1 under the unit-square lamp (radiance 1) at z = 2, \
+                 irradiance at the origin (normal +z); {} paths per run, seed {}",
+                cfg.paths, cfg.seed
+            ))
         )?;
         writeln!(
             out,
-            "{:<16} {:>11} {:<12} {:<38} {:>9}",
-            "quantity", "closed form", "method", "estimate", "time [s]"
+            "{:<16} {:>11} {:<11} {:<29} {:>8} {:>9}",
+            "quantity", "closed form", "method", "estimate", "reliable", "time [s]"
         )?;
         let mut runs = Vec::new();
         for m in Method::ALL {
@@ -439,13 +496,8 @@ fn mesh_table(cfg: &RunConfig, out: &mut impl Write) -> Result<(), Box<dyn std::
                     ("", String::new())
                 };
                 first = false;
-                writeln!(
-                    out,
-                    "{l:<16} {x:>11} {:<12} {:<38} {:>9.3}",
-                    r.method,
-                    mesh_cell(&est, *exact),
-                    r.seconds
-                )?;
+                let row = comparison_row(&format!("{l:<16}"), &x, r, &est, &signed_z(&est, *exact));
+                writeln!(out, "{row}")?;
             }
         }
     }

@@ -32,7 +32,7 @@
 use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use geosens::job::{Job, SceneSource, Target};
-use geosens::report::{Header, Report};
+use geosens::report::Report;
 use geosens::rod::{Direction, Probe, Rod};
 use geosens::shard::{Shard, State};
 use geosens::{Error, Estimate, Method, Quantity, RunConfig, RunResult, run};
@@ -42,7 +42,7 @@ use std::time::Instant;
 
 /// Monte Carlo estimates of intensity and geometric sensitivities.
 #[derive(Debug, Parser)]
-#[command(name = "geosens", version, about)]
+#[command(name = "geosens", version, about, max_term_width = 100)]
 struct Cli {
     /// What to run.
     #[command(subcommand)]
@@ -147,7 +147,7 @@ struct EstimateArgs {
     json: bool,
 }
 
-/// `--fd-step`, shared by `rod` and `flat`.
+/// `--fd-step`, shared by `rod`, `flat` and `mesh`.
 #[derive(Debug, Args)]
 struct FdArgs {
     /// Half step of `--method fd`: relative to the scene's size (the rod's
@@ -161,7 +161,12 @@ struct FdArgs {
 /// may start with `-` (`--omega -1`, `--x -inf`) so that the library, not the
 /// parser, rejects them with its domain in the message.
 #[derive(Debug, Args)]
-#[command(allow_negative_numbers = true)]
+#[command(
+    allow_negative_numbers = true,
+    // clap does not wrap the usage line: the probe's six values on two.
+    override_usage = "geosens rod --method <METHOD> --ks <KS> --ke <KE> --length <LENGTH> \
+                      --x <X>\n           --omega <OMEGA> [OPTIONS]"
+)]
 struct RodArgs {
     /// Estimation method (`exact` evaluates the Bellman–Wing solution).
     #[arg(long, value_enum)]
@@ -206,8 +211,8 @@ struct CompareArgs {
 /// Run configuration, shared by both subcommands.
 #[derive(Debug, Args)]
 struct RunArgs {
-    /// Number of paths per run, at least 2 [default: 1000000 for `rod`,
-    /// 200000 for `compare`] (`exact` samples none but checks it too).
+    /// Number of paths per run, at least 2 [default: 1000000; 200000 for
+    /// `compare`] (the rod's `exact` samples none but checks it too).
     // Hyphen values allowed so that `--paths -5` is named in the error
     // ("invalid value '-5' for '--paths'") instead of an unexpected `-5`.
     #[arg(long, allow_hyphen_values = true)]
@@ -269,12 +274,6 @@ fn slot(q: &Quantity) -> usize {
         Quantity::Sensitivity(_) => 1,
         Quantity::Gradient(_) => 2,
     }
-}
-
-/// The exact solution as a [`RunResult`] (stderr 0, `paths` 0: nothing is
-/// sampled; `seconds` is the time of the evaluation).
-fn exact_result(rod: &Rod, probe: &Probe) -> Result<RunResult, Error> {
-    geosens::job::exact_result(&Header::Rod(geosens::report::RodProbe::of(rod, probe)))
 }
 
 mod commands;

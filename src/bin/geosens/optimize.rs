@@ -157,43 +157,72 @@ fn run<S: Model>(
             );
         }
         if !args.json {
-            writeln!(
+            write!(
                 out,
-                "mean of iterates {}..{}: {}",
-                last.iteration.div_ceil(2),
-                last.iteration,
-                listed(&last.average)
+                "{}",
+                super::output::paragraph(&format!(
+                    "mean of iterates {}..{}: {}",
+                    last.iteration.div_ceil(2),
+                    last.iteration,
+                    listed(&last.average)
+                ))
             )?;
         }
     }
     Ok(())
 }
 
-fn header(names: &[String]) -> String {
-    let mut h = format!("{:>5} {:>24}", "iter", "loss ± stderr");
-    for n in names {
-        h += &format!(" {:>12} {:>22}", n, format!("∂loss/∂{n}"));
-    }
-    h + "    paths  seconds"
+/// Width of the table's parameter column: the longest name.
+fn name_width(names: &[String]) -> usize {
+    names
+        .iter()
+        .map(|n| n.chars().count())
+        .chain(["parameter".len()])
+        .max()
+        .unwrap_or(0)
 }
 
+/// The table's column titles. A row per parameter, not a column pair: a
+/// scene of three parameters made lines of 169 characters.
+fn header(names: &[String]) -> String {
+    let w = name_width(names);
+    format!(
+        "{:>5} {:>22} {:>8} {:>7}  {:<w$} {:>10} {:>20}",
+        "iter", "loss ± stderr", "paths", "seconds", "parameter", "value", "∂loss/∂π ± stderr"
+    )
+}
+
+/// One iteration's rows: the loss, paths and time on the first, then one
+/// row per parameter (its value and the gradient's component), and its
+/// notes on lines of their own.
 fn row(r: &Record, names: &[String]) -> String {
-    let mut s = format!(
-        "{:>5} {:>24}",
-        r.iteration,
-        format!("{:.6e} ± {:.1e}", r.loss.mean, r.loss.stderr)
-    );
-    for n in names {
+    let w = name_width(names);
+    let mut s = String::new();
+    for (k, n) in names.iter().enumerate() {
         let g = r.gradient[n];
+        let lead = if k == 0 {
+            format!(
+                "{:>5} {:>22} {:>8} {:>7.3}",
+                r.iteration,
+                format!("{:.6e} ± {:.1e}", r.loss.mean, r.loss.stderr),
+                r.paths,
+                r.seconds
+            )
+        } else {
+            " ".repeat(45)
+        };
+        if k > 0 {
+            s.push('\n');
+        }
         s += &format!(
-            " {:>12.6} {:>22}",
+            "{lead}  {n:<w$} {:>10.6} {:>20}",
             r.parameters[n],
             format!("{:.4e} ± {:.1e}", g.mean, g.stderr)
         );
     }
-    s += &format!(" {:>8} {:>8.3}", r.paths, r.seconds);
     for note in &r.notes {
-        s += &format!("  [{note}]");
+        s.push('\n');
+        s += super::output::paragraph(&format!("note: {note}")).trim_end();
     }
     s
 }

@@ -74,3 +74,37 @@ pub(super) fn shown(bar: &indicatif::ProgressBar) -> impl Fn(u64) -> Result<(), 
         Ok(())
     }
 }
+
+/// The widest line the commands print: their tables, titles and notes (the
+/// help, which clap wraps, too).
+pub(super) const WIDTH: usize = 100;
+
+/// `text` wrapped at spaces into lines of at most [`WIDTH`] characters, the
+/// lines after the first indented by two spaces, so that a reader (and a
+/// parser) tells a wrapped title or note from a table's rows; every line
+/// ends with a newline. A word longer than a line keeps a line to itself.
+pub(super) fn paragraph(text: &str) -> String {
+    let mut out = String::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let indent = if out.is_empty() { 0 } else { 2 };
+        if !line.is_empty() && indent + line.chars().count() + 1 + word.chars().count() > WIDTH {
+            out.push_str(&" ".repeat(indent));
+            out.push_str(&line);
+            out.push('\n');
+            line.clear();
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    if !line.is_empty() {
+        if !out.is_empty() {
+            out.push_str("  ");
+        }
+        out.push_str(&line);
+        out.push('\n');
+    }
+    out
+}

@@ -15,50 +15,48 @@ use geosens::job::SceneSource;
 use geosens::job::{ImageReport, RenderJob};
 use std::path::{Path, PathBuf};
 
-/// `geosens render`: a camera scene, a method, paths per pixel, a folder.
+/// `geosens render`: a camera scene, a method, paths per pixel, and where
+/// the result goes: a folder of images (`--out`) or, for a shard, a state
+/// file (`--state`); one of the two is required.
 #[derive(Debug, Args)]
+#[command(group = clap::ArgGroup::new("output").required(true).args(["out", "state"]))]
 pub(super) struct RenderArgs {
     /// Scene file (3D, or flatland for a line camera) with `[sensor] kind =
     /// "camera"`.
     #[arg(long)]
     scene: PathBuf,
-    /// Estimation method.
+    /// Estimation method: the images of `I` and of every `∂I/∂π` (each
+    /// pixel's estimate, its standard error beside it).
     #[arg(long, value_enum)]
     method: Method,
     /// Paths per pixel, at least 2.
     #[arg(long, default_value_t = 64, allow_hyphen_values = true)]
     spp: u64,
-    /// Folder the images go to (created if missing); not with `--state`.
-    #[arg(long, required_unless_present = "state")]
+    /// Folder the images go to (created if missing): `I`, `d_<parameter>`
+    /// and their `_stderr` images as EXR, .npy and PNG.
+    #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// The finite differences' half step.
-    #[command(flatten)]
-    fd: FdArgs,
+    /// Half step of `--method fd`, used at every pixel: times the scene's
+    /// size for a translation, radians for a rotation, the relative change
+    /// for a scale; in [1e-12, 1) [default: 0.001]. A larger step: less
+    /// noise in the images, a bias of O(step²).
+    #[arg(long, allow_hyphen_values = true)]
+    fd_step: Option<f64>,
     /// Seed of the random streams.
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Worker threads, 0 = all cores (images do not depend on it).
     #[arg(long, default_value_t = 0, allow_hyphen_values = true)]
     threads: usize,
-    /// Sharding (by pixels of the image).
-    #[command(flatten)]
-    shard: RenderShardArgs,
-}
-
-/// `--shard I/N --state FILE` of `geosens render`: [`ShardArgs`] with the
-/// help of a rendering's shards.
-#[derive(Debug, Args)]
-pub(super) struct RenderShardArgs {
-    /// Render only shard I of N of the image (1 ≤ I ≤ N): the image's
-    /// pixels, row by row from the top, split into N contiguous shares of
-    /// nearly equal counts (so a single row splits too; past one shard per
-    /// pixel the others are empty), each with all `--spp` paths of its
-    /// pixels; needs `--state`.
-    #[arg(long, value_name = "I/N")]
+    /// Render only shard I of N of the image (1 ≤ I ≤ N): its pixels, row
+    /// by row from the top, split into N shares of nearly equal counts,
+    /// each pixel with all `--spp` paths; needs `--state`.
+    #[arg(long, value_name = "I/N", requires = "state")]
     shard: Option<Shard>,
-    /// Write the shard's exact state (its pixels' sums) to FILE (JSON)
-    /// instead of images; `geosens merge --out DIR` writes the images from
-    /// all states. Without `--shard`, the whole image is one shard (1/1).
+    /// Instead of images, write the shard's exact state (its pixels' sums)
+    /// to FILE (JSON); `geosens merge --out DIR FILE…` writes the images
+    /// from all the shards' states. Without `--shard`, the whole image is
+    /// one shard (1/1).
     #[arg(long, value_name = "FILE")]
     state: Option<PathBuf>,
 }
@@ -140,18 +138,11 @@ pub(super) fn render_command(
     let job = RenderJob {
         scene: SceneSource::File(args.scene.clone()),
         method: args.method,
-        fd_step: args.fd.fd_step,
+        fd_step: args.fd_step,
     };
-    if let Some(path) = &args.shard.state {
-        if args.out.is_some() {
-            return Err(Error::Config(
-                "--state writes the shard's state, not images: `geosens merge --out DIR` writes them"
-                    .into(),
-            )
-            .into());
-        }
+    if let Some(path) = &args.state {
         super::output::writable_file(path)?;
-        let which = args.shard.shard.unwrap_or(Shard::WHOLE);
+        let which = args.shard.unwrap_or(Shard::WHOLE);
         let state = job.run_shard(
             args.spp,
             args.seed,
@@ -160,20 +151,20 @@ pub(super) fn render_command(
             &geosens::runner::quiet,
         )?;
         state.write(path)?;
-        eprintln!(
-            "wrote shard {which} ({} paths) to {}",
-            state.paths,
-            path.display()
+        eprint!(
+            "{}",
+            super::output::paragraph(&format!(
+                "wrote shard {which} ({} paths) to {}",
+                state.paths,
+                path.display()
+            ))
         );
         return Ok(());
     }
-    if let Some(s) = args.shard.shard {
-        return Err(Error::Config(format!(
-            "--shard {s} needs --state FILE, where the shard's state goes"
-        ))
-        .into());
-    }
-    let dir = args.out.as_deref().ok_or("--out DIR is needed")?;
+    // clap requires one of --out and --state.
+    let Some(dir) = args.out.as_deref() else {
+        return Err(Error::Config("--out DIR says where the images go".into()).into());
+    };
     let (estimator, _) = job.prepare()?;
     // The folders made for the images go again if the run fails.
     let made = super::output::missing_folders(dir);
@@ -222,18 +213,21 @@ pub(super) fn finish(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let text = report.json()? + "\n";
     for w in report.warnings() {
-        eprintln!("{w}");
+        eprint!("{}", super::output::paragraph(&w));
     }
     let result = &report.result;
     let written = write_images(result, dir)?;
-    eprintln!(
-        "wrote {} files to {} ({}×{} pixels, {} paths per pixel, {:.2} s)",
-        written.len(),
-        dir.display(),
-        result.width,
-        result.height,
-        result.spp,
-        result.seconds
+    eprint!(
+        "{}",
+        super::output::paragraph(&format!(
+            "wrote {} files to {} ({}×{} pixels, {} paths per pixel, {:.2} s)",
+            written.len(),
+            dir.display(),
+            result.width,
+            result.height,
+            result.spp,
+            result.seconds
+        ))
     );
     out.write_all(text.as_bytes())?;
     Ok(())
