@@ -1,6 +1,6 @@
 //! The methods compared by what an optimisation costs to reach the answer
-//! (issue 32 point 6; book: "Sensitivities at work", "Comparing methods by
-//! time to the answer").
+//! (book: "Sensitivities at work", "Comparing methods by time to the
+//! answer").
 //!
 //! ```text
 //! cargo run --release --example optimize_compare -- [OUT_DIR] [EFFORT] [SEEDS]
