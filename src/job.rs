@@ -190,6 +190,77 @@ pub enum Target {
     Mesh(SceneSource),
 }
 
+/// The closed form of a [`Target`] ([`Target::exact`]): `I`, every
+/// parameter's `∂I/∂π` by name, and the sensor's spatial gradient by axis
+/// where it is known, in the order the estimates' JSON line gives them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Exact {
+    /// `I` (a scene's: the irradiance `E`).
+    pub intensity: f64,
+    /// `∂I/∂π` per parameter: the rod's `length`, a scene's parameters.
+    pub sensitivity: Vec<(String, f64)>,
+    /// `∂I/∂x`, … at the sensor: the rod's `x`, flatland's `x`, `y`;
+    /// `None` in 3D, whose closed form does not give it.
+    pub gradient: Option<Vec<(String, f64)>>,
+}
+
+impl Target {
+    /// The target's closed form, nothing sampled: the rod's Bellman–Wing
+    /// solution ([`crate::rod::exact`]), a flatland scene's
+    /// ([`flat::exact::Reference`]: an irradiance sensor, one emitter
+    /// segment, black occluders, at most one absorbing medium) or a 3D
+    /// scene's ([`mesh::exact::Reference`]: an irradiance sensor, a flat
+    /// convex emitter, at most one convex black occluder). A scene without
+    /// one is an [`Error::Scene`] that names it and says why.
+    pub fn exact(&self) -> Result<Exact, Error> {
+        let named = |source: &SceneSource, e: Error| match e {
+            Error::Scene(msg) => Error::Scene(format!("{}: {msg}", source.name())),
+            other => other,
+        };
+        let names = |params: Vec<String>, value: &dyn Fn(usize) -> f64| {
+            params
+                .into_iter()
+                .enumerate()
+                .map(|(j, name)| (name, value(j)))
+                .collect()
+        };
+        match self {
+            Target::Rod(given) => {
+                let (rod, probe) = given.build()?;
+                let [i, s, g] = rod_exact(&rod, &probe);
+                Ok(Exact {
+                    intensity: i,
+                    sensitivity: vec![(crate::rod::PARAMETER.to_owned(), s)],
+                    gradient: Some(vec![("x".to_owned(), g)]),
+                })
+            }
+            Target::Flat(source) => {
+                source.check_dimension(2)?;
+                let scene = source.flat()?;
+                let r = flat::exact::Reference::for_scene(&scene).map_err(|e| named(source, e))?;
+                let (gx, gy) = r.gradient();
+                let params = scene.parameters().iter().map(|p| p.name.clone()).collect();
+                Ok(Exact {
+                    intensity: r.value(),
+                    sensitivity: names(params, &|j| r.derivative(j)),
+                    gradient: Some(vec![("x".to_owned(), gx), ("y".to_owned(), gy)]),
+                })
+            }
+            Target::Mesh(source) => {
+                source.check_dimension(3)?;
+                let scene = source.mesh()?;
+                let r = mesh::exact::Reference::for_scene(&scene).map_err(|e| named(source, e))?;
+                let params = scene.parameters().iter().map(|p| p.name.clone()).collect();
+                Ok(Exact {
+                    intensity: r.value(),
+                    sensitivity: names(params, &|j| r.derivative(j)),
+                    gradient: None,
+                })
+            }
+        }
+    }
+}
+
 /// One estimation: a target, a method and the finite differences' step.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Job {

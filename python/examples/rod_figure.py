@@ -8,7 +8,7 @@ rendering, expectation differentiation, the transport model, central finite
 differences, whose probe stays inside the rod: x < 2); columns: the paper's thin rod (κs = 0.07, κe = 0.1) and thick
 rod (κs = 2.1, κe = 3), length 2. Each panel: the estimates at 21 positions,
 both directions, with ±σ error bars, over the exact curves
-(``method="exact"``). Needs matplotlib (``pip install matplotlib``); a few
+(``geosens.rod_exact``). Needs matplotlib (``pip install matplotlib``); a few
 seconds on two cores with the default 100000 paths per point.
 """
 
@@ -38,10 +38,7 @@ def along(method, ks, ke, omega, xs, **run):
         geosens.rod(method, ks, ke, LENGTH, x, omega, seed=seed + i, **run)
         for i, x in enumerate(xs)
     ]
-    return (
-        np.array([r["sensitivity"]["mean"] for r in rs]),
-        np.array([r["sensitivity"]["stderr"] for r in rs]),
-    )
+    return geosens.arrays(rs)["sensitivity"]["length"]
 
 
 def figure(paths: int = 100_000, seed: int = 1):
@@ -54,7 +51,7 @@ def figure(paths: int = 100_000, seed: int = 1):
         for row, method in enumerate(METHODS):
             ax = axes[row][col]
             for k, (omega, (label, color)) in enumerate(DIRECTIONS.items()):
-                exact, _ = along("exact", ks, ke, omega, fine)
+                exact = geosens.rod_exact(ks, ke, LENGTH, fine, omega)["sensitivity"]["length"]
                 ax.plot(fine, exact, color=color, lw=1, label=f"exact, {label}")
                 # fd shortens the rod: its probe must stay inside (x < length).
                 at = xs[xs < LENGTH] if method == "fd" else xs

@@ -5,13 +5,25 @@ subcommand runs and returns what ``--json`` prints, parsed::
 
     >>> import geosens
     >>> r = geosens.rod("expectation", 0.07, 0.1, 2.0, 1.0, 1.0, paths=100_000)
-    >>> r["sensitivity"]["mean"], r["sensitivity"]["stderr"]
+    >>> r["sensitivity"]["length"]["mean"], r["sensitivity"]["length"]["stderr"]
 
-- :func:`rod`, :func:`flat`, :func:`mesh` return the dict of the command
-  line's JSON line (``geosens rod|flat|mesh ... --json``), identical bit for
-  bit for the same seed but for ``"seconds"``;
-- :func:`render` returns the JSON line of ``geosens render`` with the images
-  added under ``"images"`` as float64 arrays of shape (height, width);
+- :func:`rod`, :func:`flat`, :func:`mesh` return the numbers of the
+  command line's JSON line (``geosens rod|flat|mesh ... --json``), identical
+  bit for bit for the same seed but for ``"seconds"``, in one layout for
+  all three: ``{"method", "intensity", "sensitivity": {parameter: q},
+  "gradient": {axis: q} or None, "paths", "seconds"}``, each quantity ``q``
+  a dict ``{"mean", "stderr", "nonzero", "reliable"}`` (the rod's one
+  parameter is ``"length"``, its one axis ``"x"``);
+- :func:`render` returns the JSON line of ``geosens render`` (``"intensity"``
+  and ``"sensitivity"`` as above: the images' mean pixel values) with the
+  images added under ``"images"`` as float64 arrays of shape (height, width);
+- :func:`arrays` turns a list of results (a sweep) into arrays: each
+  quantity's means and standard errors;
+- :func:`rod_exact`, :func:`flat_exact` and :func:`mesh_exact` give the
+  closed forms (the rod's Bellman–Wing solution along the rod, flatland's
+  and 3D's occluder scenes), in the same layout, nothing sampled;
+- :func:`from_json` reads a line the command line printed into the same
+  layout;
 - :func:`optimize` runs ``geosens optimize --json`` on a scene with
   ``measurements`` and an ``objective`` and returns its records, one dict
   per iteration;
@@ -23,7 +35,7 @@ A scene is a file (TOML or JSON, a ``str`` or ``os.PathLike``) or a dict with
 the file's schema, so that a notebook can sweep a parameter by editing it
 (OBJ paths in a dict are relative to the current directory). Bad input
 raises :class:`ValueError` with the command line's message; the estimator's
-caveats are issued as :class:`RuntimeWarning`. The GIL is released while
+caveats are issued as :class:`RuntimeWarning`, at the caller's line. The GIL is released while
 paths are sampled, so other Python threads run meanwhile.
 
 Ctrl-C stops a run called from Python's main thread (``KeyboardInterrupt``).
@@ -50,15 +62,30 @@ from __future__ import annotations
 import json
 import operator
 import os
+import sys
 import threading
 import warnings
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _geosens
 
-__all__ = ["rod", "flat", "mesh", "render", "merge", "optimize", "__version__"]
+__all__ = [
+    "rod",
+    "flat",
+    "mesh",
+    "render",
+    "merge",
+    "optimize",
+    "arrays",
+    "Series",
+    "rod_exact",
+    "flat_exact",
+    "mesh_exact",
+    "from_json",
+    "__version__",
+]
 
 __version__: str = _geosens.__version__
 
@@ -72,6 +99,122 @@ StateLike = Union[Dict[str, Any], str, "os.PathLike[str]"]
 #: What stops a run: a :class:`threading.Event` (anything with ``is_set()``)
 #: or a callable of no argument, true to stop.
 Stop = Union[threading.Event, Callable[[], Any]]
+
+
+#: The package's folder: frames of files in it are not the caller's.
+_HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _warn(message: str, category: type) -> None:
+    """Issues a warning at the first line outside this package up the
+    stack, the user's, however deep in the package it was raised (a fixed
+    ``stacklevel`` is right for one call depth only)."""
+    frame: Optional[Any] = sys._getframe(1)
+    level = 2  # the frame of _warn's caller
+    while frame is not None and os.path.dirname(
+        os.path.abspath(frame.f_code.co_filename)
+    ) == _HERE:
+        frame = frame.f_back
+        level += 1
+    warnings.warn(message, category, stacklevel=level)
+
+
+#: The rod's one shape parameter and one axis, as its results name them.
+_ROD_PARAMETER = "length"
+_ROD_AXIS = "x"
+#: The keys of a quantity, which a rod result's ``"sensitivity"`` had
+#: before it became ``{"length": quantity}``.
+_QUANTITY_KEYS = ("mean", "stderr", "nonzero", "reliable", "jumps", "caveat")
+
+
+class _Result(dict):
+    """A result: a plain dict, but for the keys of the earlier layout, which
+    still read (through :meth:`_old`) with a :class:`DeprecationWarning`
+    at the caller's line. Old keys are not listed, iterated or saved."""
+
+    def _old(self, key: Any) -> Optional[Tuple[str, str, Any]]:
+        """The old ``key``'s spelling, its new one and its value, or None."""
+        return None
+
+    def __missing__(self, key: Any) -> Any:
+        old = self._old(key)
+        if old is None:
+            raise KeyError(key)
+        spelling, new, value = old
+        _warn(f"the earlier layout's key {spelling}: use {new}", DeprecationWarning)
+        return value
+
+    def get(self, key: Any, default: Any = None) -> Any:
+        if key in self or self._old(key) is not None:
+            return self[key]
+        return default
+
+
+class _RodResult(_Result):
+    """A rod's result: ``"gradient_x"`` was ``result["gradient"]["x"]``."""
+
+    def _old(self, key: Any) -> Optional[Tuple[str, str, Any]]:
+        if key != "gradient_x":
+            return None
+        g = dict.get(self, "gradient")
+        return ('r["gradient_x"]', 'r["gradient"]["x"]', None if g is None else g[_ROD_AXIS])
+
+
+class _RodSensitivity(_Result):
+    """A rod's ``"sensitivity"``: ``{"length": quantity}``, which was the
+    quantity itself (``r["sensitivity"]["mean"]``)."""
+
+    def _old(self, key: Any) -> Optional[Tuple[str, str, Any]]:
+        q = dict.get(self, _ROD_PARAMETER)
+        if key not in _QUANTITY_KEYS or q is None or key not in q:
+            return None
+        return (f'r["sensitivity"]["{key}"]', f'r["sensitivity"]["length"]["{key}"]', q[key])
+
+
+class _RenderResult(_Result):
+    """A rendering's result: ``"I"`` is ``"intensity"``, as elsewhere."""
+
+    def _old(self, key: Any) -> Optional[Tuple[str, str, Any]]:
+        if key != "I" or "intensity" not in self:
+            return None
+        return ('r["I"]', 'r["intensity"]', dict.__getitem__(self, "intensity"))
+
+
+def _uniform(line: Dict[str, Any]) -> Dict[str, Any]:
+    """The command line's JSON line in the package's one layout: the rod's
+    ``"sensitivity"`` (a quantity, or null) becomes ``{"length": q}`` (or
+    ``{}``) and its ``"gradient_x"`` ``"gradient": {"x": q}`` (or None), as
+    flatland and 3D give them; a rendering's ``"I"`` becomes
+    ``"intensity"``. Other dicts (a shard's state) are returned as they are."""
+    if "gradient_x" in line and "gradient" not in line:
+        rod = _RodResult()
+        for key, value in line.items():
+            if key == "sensitivity":
+                rod[key] = _RodSensitivity({} if value is None else {_ROD_PARAMETER: value})
+            elif key == "gradient_x":
+                rod["gradient"] = None if value is None else {_ROD_AXIS: value}
+            else:
+                rod[key] = value
+        return rod
+    if "I" in line and "intensity" not in line and "width" in line:
+        return _RenderResult(("intensity" if k == "I" else k, v) for k, v in line.items())
+    return line
+
+
+def from_json(line: Union[str, bytes, Dict[str, Any]]) -> Dict[str, Any]:
+    """A line the command line printed (``geosens rod|flat|mesh ... --json``,
+    ``geosens render``, ``geosens merge``), as JSON text or already parsed,
+    in the layout the package's functions return (a rendering: without its
+    images, which are files).
+
+    Raises:
+        ValueError: the text is not JSON.
+    """
+    if isinstance(line, (str, bytes)):
+        line = json.loads(line)
+    if not isinstance(line, dict):
+        raise ValueError(f"a result line is a JSON object, not {type(line).__name__}")
+    return _uniform(line)
 
 
 def _uint(name: str, value: Any) -> int:
@@ -164,15 +307,14 @@ def _scene(scene: Scene) -> Tuple[Optional[str], Optional[str]]:
     )
 
 
-def _result(outcome: Tuple[str, str, List[str], list], stacklevel: int = 3) -> Dict[str, Any]:
-    """The Python result of a Rust call: its JSON parsed, its warnings
-    issued (``stacklevel``: at the line of the user's code, which called the
-    public function that called this one, 3, or the helper that did, 4),
-    a rendering's images as arrays."""
+def _result(outcome: Tuple[str, str, List[str], list]) -> Dict[str, Any]:
+    """The Python result of a Rust call: its JSON parsed into the one
+    layout, its warnings issued at the user's line, a rendering's images as
+    arrays."""
     kind, text, warns, images = outcome
     for w in warns:
-        warnings.warn(w.removeprefix("warning: "), RuntimeWarning, stacklevel=stacklevel)
-    result = json.loads(text)
+        _warn(w.removeprefix("warning: "), RuntimeWarning)
+    result = _uniform(json.loads(text)) if kind != "state" else json.loads(text)
     if kind == "image":
         result["images"] = {
             key: {
@@ -223,11 +365,14 @@ def rod(
             the main thread only; ``stop`` stops one called from another.
 
     Returns:
-        ``{"method", "intensity", "sensitivity", "gradient_x", "paths",
-        "seconds"}``, each quantity ``{"mean", "stderr", "nonzero",
-        "reliable"}`` (``fd``'s derivative also ``"jumps"``) or None if the
-        method does not estimate it; or, with
-        ``shard``, the shard's state.
+        ``{"method", "intensity", "sensitivity": {"length": q}, "gradient":
+        {"x": q}, "paths", "seconds"}``, the layout of :func:`flat`'s, each
+        quantity ``q`` a dict ``{"mean", "stderr", "nonzero", "reliable"}``
+        (``fd``'s derivative also ``"jumps"``, a caveated one ``"caveat"``);
+        ``"sensitivity"`` is ``{}`` for ``intensity``, ``"gradient"`` None
+        but for ``transport`` and ``exact``. Or, with ``shard``, the shard's
+        state. The keys of the earlier layout (``r["sensitivity"]["mean"]``,
+        ``r["gradient_x"]``) still read, with a DeprecationWarning.
 
     Raises:
         ValueError: bad input, with the command line's message.
@@ -274,9 +419,7 @@ def _scene_run(
             _fd_step(fd_step),
             _shard(shard),
             _stop(stop),
-        ),
-        # user → flat/mesh → _scene_run → _result
-        stacklevel=4,
+        )
     )
 
 
@@ -299,9 +442,10 @@ def flat(
         paths, seed, threads, fd_step, shard, stop: as for :func:`rod`.
 
     Returns:
-        ``{"method", "intensity", "sensitivity": {param: …}, "gradient"
-        (transport's ∂I/∂x, ∂I/∂y, else None), "paths", "seconds"}``; or,
-        with ``shard``, the shard's state.
+        ``{"method", "intensity": q, "sensitivity": {param: q}, "gradient":
+        {"x": q, "y": q} (transport's ∂I/∂x, ∂I/∂y, else None), "paths",
+        "seconds"}``, each ``q`` as for :func:`rod`; or, with ``shard``, the
+        shard's state.
 
     Raises:
         ValueError: bad input, with the command line's message.
@@ -344,9 +488,11 @@ def render(
     rendering ends at its next pixel).
 
     Returns:
-        The command line's JSON line (``"method"``, ``"I"``,
+        The command line's JSON line (``"method"``, ``"intensity"`` (the
+        line's ``"I"``, which still reads, with a DeprecationWarning) and
         ``"sensitivity"``: the images' mean pixel values with their standard
-        errors, ``"width"``, ``"height"``, ``"paths"``, ``"seconds"``) and
+        errors, as :func:`flat` gives them; ``"width"``, ``"height"``,
+        ``"paths"``, ``"seconds"``) and
         ``"images"``: ``{"I": {"mean": array, "stderr": array}, param: {…},
         …}``, float64 arrays of shape (height, width), row 0 at the top (the
         command line's ``I.npy``, ``I_stderr.npy``, ``d_<param>.npy``, …);
@@ -390,7 +536,7 @@ def merge(states: Sequence[StateLike]) -> Dict[str, Any]:
     """
     if isinstance(states, (str, dict, os.PathLike)):
         raise ValueError("merge takes a list of states")
-    items = []
+    items: List[Tuple[str, Optional[str], Optional[str]]] = []
     for k, s in enumerate(states):
         if isinstance(s, dict):
             items.append((f"states[{k}]", None, json.dumps(s)))
@@ -404,6 +550,186 @@ def merge(states: Sequence[StateLike]) -> Dict[str, Any]:
                 f"not {type(s).__name__}"
             )
     return _result(_geosens.merge(items))
+
+
+class Series(NamedTuple):
+    """One quantity over a list of results: its means and standard errors,
+    float64 arrays with one entry per result (a rendering's images: one
+    image per result, shape (n, height, width)). Unpacks as ``mean, stderr
+    = series``."""
+
+    mean: np.ndarray
+    stderr: np.ndarray
+
+
+#: A value missing from a result (None is a value: "not estimated").
+_MISSING = object()
+
+
+def _is_quantity(value: Any) -> bool:
+    return isinstance(value, dict) and "mean" in value and "stderr" in value
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_))
+
+
+def _kind(value: Any) -> str:
+    """What :func:`arrays` makes of a value: a quantity, a dict to walk, a
+    number, None, or something else (text, flags, lists: left out)."""
+    if value is None:
+        return "None (not estimated)"
+    if _is_quantity(value):
+        return "a quantity"
+    if isinstance(value, dict):
+        return "a dict"
+    if _is_number(value):
+        return "a number"
+    return "other"
+
+
+def _stack(items: List[Dict[str, Any]], where: str) -> Dict[str, Any]:
+    """:func:`arrays` on dicts found at the same place ``where`` of each
+    result."""
+    out: Dict[str, Any] = {}
+    for key in items[0]:
+        values = [dict.get(item, key, _MISSING) for item in items]
+        at = f"{where}[{key!r}]"
+        kinds = [None if v is _MISSING else _kind(v) for v in values]
+        if kinds[0] == "other":
+            continue
+        for k, kind in enumerate(kinds):
+            if kind is None:
+                raise ValueError(f"arrays: results[{k}] has no {at}, results[0] has")
+            if kind != kinds[0]:
+                raise ValueError(
+                    f"arrays: results[{k}]{at} is {kind} where results[0]'s is {kinds[0]}"
+                )
+        if kinds[0] == "a quantity":
+            out[key] = Series(
+                np.array([v["mean"] for v in values], dtype=np.float64),
+                np.array([v["stderr"] for v in values], dtype=np.float64),
+            )
+        elif kinds[0] == "a dict":
+            out[key] = _stack(values, at)
+        elif kinds[0] == "a number":
+            out[key] = np.array(values)
+        else:
+            out[key] = None
+    return out
+
+
+def arrays(results: Union[Dict[str, Any], Sequence[Dict[str, Any]]]) -> Dict[str, Any]:
+    """A list of results (a sweep: one result per point) as arrays, in the
+    layout of one result: where a result holds a quantity (a dict with
+    ``"mean"`` and ``"stderr"``), a :class:`Series` of its means and
+    standard errors; where it holds a number (``"paths"``, ``"seconds"``,
+    an optimisation record's ``"parameters"``), an array of them; None
+    where no result estimates the quantity. Text and flags are left out.
+    Works on what :func:`rod`, :func:`flat`, :func:`mesh`, :func:`render`
+    and :func:`merge` return and on :func:`optimize`'s records::
+
+        rs = [geosens.rod("expectation", 2.1, 3.0, 2.0, x, -1, seed=i)
+              for i, x in enumerate(xs)]
+        s, err = geosens.arrays(rs)["sensitivity"]["length"]
+        plt.errorbar(xs, s, err)
+
+    A single result gives arrays of one entry.
+
+    Raises:
+        ValueError: the results do not hold the same quantities (another
+            scene's parameters, a method that does not estimate one of
+            them); the message names the first that differs.
+    """
+    items = [results] if isinstance(results, dict) else list(results)
+    if not items:
+        raise ValueError("arrays: no results")
+    for k, r in enumerate(items):
+        if not isinstance(r, dict):
+            raise ValueError(f"arrays: results[{k}] is not a result dict ({type(r).__name__})")
+    return _stack(items, "")
+
+
+def _closed(closed: Tuple[float, List[Tuple[str, float]], Optional[List[Tuple[str, float]]]]) -> Dict[str, Any]:
+    intensity, sensitivity, gradient = closed
+    return {
+        "intensity": intensity,
+        "sensitivity": dict(sensitivity),
+        "gradient": None if gradient is None else dict(gradient),
+    }
+
+
+def rod_exact(
+    ks: float, ke: float, length: float, x: Any, omega: float
+) -> Dict[str, Any]:
+    """The rod's exact (Bellman–Wing) solution at ``x``: a position, or a
+    sequence or array of them (the curve along the rod), in the layout of
+    :func:`rod`'s result with numbers for quantities::
+
+        {"intensity": I, "sensitivity": {"length": ∂I/∂length},
+         "gradient": {"x": ∂I/∂x}}
+
+    each a float, or for a sequence ``x`` a float64 array of its shape.
+    ``ks``, ``ke``, ``length``, ``omega`` as for :func:`rod`. The numbers
+    are those of ``rod("exact", …)`` and of ``geosens rod --method exact``.
+
+    Raises:
+        ValueError: bad input (an ``x`` off the rod, ``omega`` not ±1), with
+            the command line's message.
+    """
+    scalar = np.ndim(x) == 0
+    if scalar:
+        xs = [_real("x", x)]
+        shape: Tuple[int, ...] = ()
+    else:
+        try:
+            grid = np.asarray(x, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(f"invalid value {x!r} for x: expected numbers") from None
+        xs, shape = grid.ravel().tolist(), grid.shape
+    i, s, g = _geosens.rod_exact(
+        _real("ks", ks), _real("ke", ke), _real("length", length), xs, _real("omega", omega)
+    )
+    pick = (lambda v: v[0]) if scalar else (lambda v: np.array(v, dtype=np.float64).reshape(shape))
+    return {
+        "intensity": pick(i),
+        "sensitivity": {_ROD_PARAMETER: pick(s)},
+        "gradient": {_ROD_AXIS: pick(g)},
+    }
+
+
+def flat_exact(scene: Scene) -> Dict[str, Any]:
+    """The closed form of a flatland scene (a file or a dict, as for
+    :func:`flat`), where one exists: an irradiance sensor, one emitter
+    segment, black absorbers and at most one purely absorbing medium,
+    nothing else (the medium's by quadrature to ~1e-8). In the layout of
+    :func:`flat`'s result with numbers for quantities::
+
+        {"intensity": E, "sensitivity": {param: ∂E/∂π},
+         "gradient": {"x": ∂E/∂x, "y": ∂E/∂y}}
+
+    Raises:
+        ValueError: bad input, or a scene without a closed form (the message
+            says why: a reflector, a scattering medium, a radiance sensor…).
+    """
+    path, text = _scene(scene)
+    return _closed(_geosens.scene_exact(False, path, text))
+
+
+def mesh_exact(scene: Scene) -> Dict[str, Any]:
+    """The closed form of a 3D scene (a file or a dict, as for
+    :func:`mesh`), where one exists: an irradiance sensor, one emitter that
+    is a flat convex polygon, and at most one black occluder, convex (a flat
+    polygon, or a closed body such as a box) and lying strictly between the
+    sensor and the emitter's plane; parameters move the occluder (or the
+    emitter, when there is no occluder). As :func:`flat_exact`, but
+    ``"gradient"`` is None (the closed form does not give ∂E/∂x).
+
+    Raises:
+        ValueError: bad input, or a scene without a closed form, saying why.
+    """
+    path, text = _scene(scene)
+    return _closed(_geosens.scene_exact(True, path, text))
 
 
 def optimize(

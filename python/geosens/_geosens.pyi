@@ -1,4 +1,6 @@
 # The Rust module (python/src/lib.rs); `geosens/__init__.py` wraps it.
+# rod_exact: I, ∂I/∂length, ∂I/∂x at each x; scene_exact: (I, [(parameter,
+# ∂I/∂π)], [(axis, ∂I/∂x)] or None in 3D).
 from typing import Any, Callable, List, Optional, Tuple
 
 # (kind, JSON text, warnings, images): kind is "report", "image" or "state";
@@ -29,3 +31,9 @@ def optimize(
     fd_step: Optional[float], tolerance: float, seed: int, threads: int,
     each: Optional[Callable[[str], Any]], stop: Optional[Callable[[], Any]],
 ) -> List[str]: ...
+def rod_exact(
+    ks: float, ke: float, length: float, xs: List[float], omega: float,
+) -> Tuple[List[float], List[float], List[float]]: ...
+def scene_exact(
+    mesh: bool, path: Optional[str], json: Optional[str],
+) -> Tuple[float, List[Tuple[str, float]], Optional[List[Tuple[str, float]]]]: ...

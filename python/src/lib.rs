@@ -1,7 +1,8 @@
 //! `geosens._geosens`: the Rust side of the `geosens` Python package, a thin
 //! layer over the library's jobs ([`geosens::job`]), printing
 //! ([`geosens::report`]), shards ([`geosens::shard`]) and optimisation
-//! ([`geosens::optimize`]). Every function returns the same JSON text as
+//! ([`geosens::optimize`]), and the closed forms ([`Target::exact`]).
+//! Every estimating function returns the same JSON text as
 //! the command line's `--json` line (`optimize`: lines; or a shard's
 //! state), which `geosens/__init__.py` turns into Python objects;
 //! every bad input raises `ValueError` with the library's message, the one
@@ -416,6 +417,64 @@ fn optimize(
     out.map_err(value_error)
 }
 
+/// The closed form as Python gets it: `I`, `∂I/∂π` by parameter, the
+/// sensor's gradient by axis (`None` in 3D).
+type Closed = (f64, Vec<(String, f64)>, Option<Vec<(String, f64)>>);
+
+/// The rod's Bellman–Wing solution at every probe position of `xs`
+/// (direction `omega`): `I`, `∂I/∂length` and `∂I/∂x`, one list each.
+#[pyfunction]
+fn rod_exact(
+    ks: f64,
+    ke: f64,
+    length: f64,
+    xs: Vec<f64>,
+    omega: f64,
+) -> PyResult<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let mut out = (
+        Vec::with_capacity(xs.len()),
+        Vec::with_capacity(xs.len()),
+        Vec::with_capacity(xs.len()),
+    );
+    for x in xs {
+        let probe = geosens::report::RodProbe {
+            ks,
+            ke,
+            length,
+            x,
+            omega,
+        };
+        let (rod, probe) = probe.build().map_err(value_error)?;
+        let [i, s, g] = geosens::report::rod_exact(&rod, &probe);
+        out.0.push(i);
+        out.1.push(s);
+        out.2.push(g);
+    }
+    Ok(out)
+}
+
+/// The closed form of a flatland (`mesh = false`) or 3D scene, a file
+/// (`path`) or JSON text (`json`), as [`Closed`]; `ValueError` saying why
+/// when it has none ([`Target::exact`]).
+#[pyfunction]
+#[pyo3(signature = (mesh, path, json))]
+fn scene_exact(
+    py: Python<'_>,
+    mesh: bool,
+    path: Option<PathBuf>,
+    json: Option<String>,
+) -> PyResult<Closed> {
+    let source = source(path, json)?;
+    let target = if mesh {
+        Target::Mesh(source)
+    } else {
+        Target::Flat(source)
+    };
+    // A medium's quadrature, a large mesh's loading: without the GIL.
+    let e = py.detach(|| target.exact()).map_err(value_error)?;
+    Ok((e.intensity, e.sensitivity, e.gradient))
+}
+
 /// `geosens merge`: `states` holds, per state, its name in messages and
 /// either its file or its JSON text.
 #[pyfunction]
@@ -451,6 +510,8 @@ fn _geosens(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
     m.add_function(wrap_pyfunction!(optimize, m)?)?;
+    m.add_function(wrap_pyfunction!(rod_exact, m)?)?;
+    m.add_function(wrap_pyfunction!(scene_exact, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

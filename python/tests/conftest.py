@@ -16,6 +16,8 @@ from typing import Any, Dict, List, Tuple
 
 import pytest
 
+import geosens
+
 REPO = Path(__file__).resolve().parents[2]
 SCENES = REPO / "scenes"
 
@@ -53,8 +55,10 @@ class Cli:
         return p
 
     def json(self, *args: Any) -> Dict[str, Any]:
-        """The parsed ``--json`` line of ``geosens ARGS --json``."""
-        return json.loads(self.run(*args, "--json").stdout)
+        """The ``--json`` line of ``geosens ARGS --json``, read as the
+        package reads it (:func:`geosens.from_json`: the rod's in the layout
+        of every result)."""
+        return geosens.from_json(self.run(*args, "--json").stdout)
 
     def error(self, *args: Any) -> str:
         """The message of a run that fails: its stderr minus ``error: ``."""

@@ -77,7 +77,7 @@ def test_render(cli, tmp_path, scene, method, spp):
     py = geosens.render(path, method, spp=spp, seed=4)
     p = cli.run("render", "--scene", path, "--method", method, "--spp", spp, "--seed", 4,
                 "--out", tmp_path)
-    ref = json.loads(p.stdout)
+    ref = geosens.from_json(p.stdout)
     assert_same(py, ref)
     assert list(py["images"]) == ["I", *ref["sensitivity"]]
     for key, img in py["images"].items():

@@ -119,7 +119,7 @@ def test_render_state_files_merge_as_the_command_line(cli, tmp_path):
                 "--seed", 9, "--shard", f"{i}/2", "--state", f)
         files.append(f)
     out = tmp_path / "merged"
-    ref = json.loads(cli.run("merge", *files, "--out", out).stdout)
+    ref = geosens.from_json(cli.run("merge", *files, "--out", out).stdout)
     py = geosens.merge(files)
     assert_same(py, ref)
     single = geosens.render(LINE, "expectation", spp=32, seed=9)

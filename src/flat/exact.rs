@@ -671,8 +671,10 @@ impl Reference {
     pub fn for_scene(scene: &super::Scene) -> Result<Reference, Error> {
         use super::scene::{Motion as SceneMotion, Sensor, Surface};
         let unsupported = |why: &str| Err(Error::Scene(format!("no analytic reference: {why}")));
-        let Sensor::Irradiance { point, normal } = scene.sensor() else {
-            return unsupported("the sensor measures radiance");
+        let (point, normal) = match scene.sensor() {
+            Sensor::Irradiance { point, normal } => (point, normal),
+            Sensor::Radiance { .. } => return unsupported("the sensor measures radiance"),
+            Sensor::Camera { .. } => return unsupported("the sensor is a camera"),
         };
         let mut emitter = None;
         let mut occluders = Vec::new();

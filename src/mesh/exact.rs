@@ -733,6 +733,206 @@ impl BoxScene {
     }
 }
 
+/// The closed form of a whole 3D [`Scene`](super::Scene), where one exists:
+/// an irradiance sensor, one emitter that is a flat convex polygon (any
+/// triangulation of it), and at most one black occluder, convex and lying
+/// strictly between the sensor and the emitter's plane: a flat convex
+/// polygon or a closed convex body (a box). `E` by Lambert's formula less
+/// the occluder's shadow, and every parameter's `∂E/∂π` from the vertex
+/// gradients; a parameter may move the occluder, or the emitter when no
+/// occluder is there. Built once: [`Self::value`] and [`Self::derivative`]
+/// only read.
+///
+/// Every other scene is an error that says why: a radiance sensor or a
+/// camera, a reflector or a medium, several emitters or occluders (their
+/// shadows may overlap), a curved or non-convex shape.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reference {
+    value: f64,
+    derivatives: Vec<f64>,
+}
+
+/// `Err` with the reason a scene has no closed form.
+fn no_reference<T>(why: impl std::fmt::Display) -> Result<T, Error> {
+    Err(Error::Scene(format!("no analytic reference: {why}")))
+}
+
+/// The outline of shape `s` if it is flat and convex: its vertices' convex
+/// hull in its plane, counter-clockwise about the plane's normal, as indices
+/// into `s.vertices` (no collinear vertex). `None` if the vertices are not
+/// in one plane; an error if they are but the triangles do not cover their
+/// hull once (a concave outline, a hole).
+fn flat_outline(s: &super::Shape) -> Result<Option<Vec<usize>>, Error> {
+    let area = |a: DVec3, b: DVec3, c: DVec3| (b - a).cross(c - a);
+    let newell: DVec3 = (0..s.triangles.len())
+        .map(|i| {
+            let [a, b, c] = s.triangle(i);
+            area(a, b, c)
+        })
+        .sum();
+    let size = s
+        .vertices
+        .iter()
+        .map(|&p| (p - s.vertices[0]).length())
+        .fold(0.0, f64::max);
+    if newell.length() <= crate::path::tolerance::DEGENERATE * size * size {
+        return Ok(None);
+    }
+    let nn = newell.normalize();
+    let c = nn.dot(s.vertices[0]);
+    let flat = s
+        .vertices
+        .iter()
+        .all(|&p| (nn.dot(p) - c).abs() <= crate::path::tolerance::ON_SURFACE * size);
+    if !flat {
+        return Ok(None);
+    }
+    let order = hull(&s.vertices, nn);
+    let hull_area: f64 = (1..order.len().saturating_sub(1))
+        .map(|i| {
+            let v = |k: usize| s.vertices[order[k]];
+            0.5 * area(v(0), v(i), v(i + 1)).length()
+        })
+        .sum();
+    let covered: f64 = (0..s.triangles.len())
+        .map(|i| {
+            let [a, b, c] = s.triangle(i);
+            0.5 * area(a, b, c).length()
+        })
+        .sum();
+    if order.len() < 3 || (covered - hull_area).abs() > 1e-9 * hull_area {
+        return no_reference(format!(
+            "shape {:?} is flat but not a convex polygon (its triangles cover {covered} of its \
+             outline's area {hull_area})",
+            s.name
+        ));
+    }
+    Ok(Some(order))
+}
+
+/// Whether the closed mesh `s` bounds a convex body: every vertex on the
+/// inner side of every triangle's plane.
+fn is_convex_body(s: &super::Shape) -> bool {
+    let size = s
+        .vertices
+        .iter()
+        .map(|&p| (p - s.vertices[0]).length())
+        .fold(0.0, f64::max);
+    (0..s.triangles.len()).all(|i| {
+        let [a, b, c] = s.triangle(i);
+        let n = (b - a).cross(c - a).normalize();
+        let side = |p: DVec3| n.dot(p - a);
+        let tol = crate::path::tolerance::ON_SURFACE * size;
+        s.vertices.iter().all(|&p| side(p) <= tol) || s.vertices.iter().all(|&p| side(p) >= -tol)
+    })
+}
+
+impl Reference {
+    /// The closed form for `scene`, or an error saying why it has none.
+    pub fn for_scene(scene: &super::Scene) -> Result<Reference, Error> {
+        use super::{Sensor, Surface};
+        let (x, n) = match scene.sensor() {
+            Sensor::Irradiance { point, normal } => (point, normal),
+            Sensor::Radiance { .. } => return no_reference("the sensor measures radiance"),
+            Sensor::Camera(_) => return no_reference("the sensor is a camera"),
+        };
+        let mut emitter = None;
+        let mut occluder = None;
+        for (k, s) in scene.shapes().iter().enumerate() {
+            match s.surface {
+                Surface::Emitter { radiance } => {
+                    if emitter.is_some() {
+                        return no_reference("more than one emitter");
+                    }
+                    let Some(outline) = flat_outline(s)? else {
+                        return no_reference(format!("the emitter {:?} is not flat", s.name));
+                    };
+                    emitter = Some((k, outline, radiance));
+                }
+                Surface::Absorber => {
+                    if occluder.is_some() {
+                        return no_reference("more than one occluder (their shadows may overlap)");
+                    }
+                    occluder = Some(k);
+                }
+                _ => return no_reference("reflectors and media have none"),
+            }
+        }
+        let Some((lamp_k, outline, radiance)) = emitter else {
+            return no_reference("no emitter");
+        };
+        let shapes = scene.shapes();
+        let lamp: Vec<DVec3> = outline
+            .iter()
+            .map(|&i| shapes[lamp_k].vertices[i])
+            .collect();
+        // E, the shape whose vertices the gradient is about, and those
+        // vertices.
+        let (value, moving, vertices, gradient) = match occluder {
+            None => {
+                let (e, g) = polygon_irradiance_with_gradient(x, n, &lamp, radiance)?;
+                (e, lamp_k, lamp.clone(), g)
+            }
+            Some(k) => {
+                let s = &shapes[k];
+                let (vertices, eg) = match flat_outline(s)? {
+                    Some(order) => {
+                        let v: Vec<DVec3> = order.iter().map(|&i| s.vertices[i]).collect();
+                        let eg = occluded_irradiance_with_gradient(x, n, &lamp, &v, radiance);
+                        (v, eg)
+                    }
+                    None if scene.is_closed(k as u32) && is_convex_body(s) => {
+                        let eg = body_irradiance_with_gradient(x, n, &lamp, &s.vertices, radiance);
+                        (s.vertices.clone(), eg)
+                    }
+                    None => {
+                        return no_reference(format!(
+                            "the occluder {:?} is neither a flat convex polygon nor a closed \
+                             convex body",
+                            s.name
+                        ));
+                    }
+                };
+                // The closed form's own refusals (an occluder not between
+                // the sensor and the lamp) are reasons too.
+                let (e, g) = eg.or_else(|e| match e {
+                    Error::Scene(why) => no_reference(why),
+                    other => Err(other),
+                })?;
+                (e, k, vertices, g)
+            }
+        };
+        let derivatives = scene
+            .parameters()
+            .iter()
+            .enumerate()
+            .map(|(j, p)| {
+                let k = scene.parameter_shape(j) as usize;
+                if k == moving {
+                    Ok(sensitivity(&gradient, &vertices, p.motion))
+                } else {
+                    no_reference(format!(
+                        "parameter {:?} moves the emitter, whose derivative is known here only \
+                         with no occluder",
+                        p.name
+                    ))
+                }
+            })
+            .collect::<Result<Vec<f64>, Error>>()?;
+        Ok(Reference { value, derivatives })
+    }
+
+    /// The irradiance `E`.
+    pub fn value(&self) -> f64 {
+        self.value
+    }
+
+    /// `∂E/∂π_j` for the scene's parameter `j`.
+    pub fn derivative(&self, j: usize) -> f64 {
+        self.derivatives[j]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1208,5 +1408,140 @@ mod tests {
         assert!(occluded_irradiance(O, DVec3::Z, &bent, &occ, 1.0).is_err());
         assert!(polygon_irradiance(DVec3::new(f64::NAN, 0.0, 0.0), DVec3::Z, &lamp, 1.0).is_err());
         assert!(polygon_irradiance(lamp[1], DVec3::Z, &lamp, 1.0).is_err());
+    }
+
+    /// A shipped scene file.
+    fn shipped(name: &str) -> crate::mesh::Scene {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes/mesh")
+            .join(name);
+        crate::mesh::file::load(&path).unwrap()
+    }
+
+    #[test]
+    fn reference_of_the_square_occluder_file_is_its_closed_form() {
+        // The file's mesh comes from an OBJ with its own vertex order, and
+        // its scale has no pivot (the centroid): the reference must find the
+        // outline and the pivot as `OccluderScene` states them.
+        let r = Reference::for_scene(&shipped("occluder.toml")).unwrap();
+        let s = OccluderScene::shipped(0.2, 0.1);
+        close(r.value(), s.irradiance().unwrap(), 1e-12, "E");
+        for (j, want) in s.sensitivities().unwrap().into_iter().enumerate() {
+            close(r.derivative(j), want, 1e-12, "dE");
+        }
+    }
+
+    #[test]
+    fn reference_of_the_triangle_scene_is_its_closed_form() {
+        let t = crate::mesh::cases::TriangleOccluder::NOMINAL;
+        let r = Reference::for_scene(&t.scene(&[0, 1, 2]).unwrap()).unwrap();
+        let (e, s) = t.exact().unwrap();
+        close(r.value(), e, 1e-12, "E");
+        for (j, want) in s.into_iter().enumerate() {
+            close(r.derivative(j), want, 1e-12, "dE");
+        }
+    }
+
+    #[test]
+    fn reference_of_the_cube_file_is_the_box_closed_form() {
+        let r = Reference::for_scene(&shipped("cube_shadow.toml")).unwrap();
+        let b = BoxScene::shipped(DVec3::new(0.2, 0.1, 1.0), 0.5);
+        close(r.value(), b.irradiance().unwrap(), 1e-12, "E");
+        let s = b.sensitivities().unwrap();
+        // cube_tx, cube_tz, cube_rot: the box's x, z and vertical rotation.
+        for (j, want) in [(0, s[0]), (1, s[2]), (2, s[3])] {
+            close(r.derivative(j), want, 1e-12, "dE");
+        }
+        // cube_tilt, about x through the centre: a Richardson difference of
+        // the tilted box's irradiance.
+        let tilt = Motion::Rotate {
+            axis: DVec3::X,
+            pivot: Some(b.centre),
+        };
+        let e = |h: f64| {
+            let q = b.corners().map(|q| tilt.apply(q, h));
+            body_irradiance_with_gradient(O, DVec3::Z, &b.lamp(), &q, 1.0)
+                .unwrap()
+                .0
+        };
+        close(r.derivative(3), richardson(&e, 1e-3), 1e-7, "dE/dtilt");
+    }
+
+    #[test]
+    fn reference_moves_the_emitter_when_nothing_occludes() {
+        use crate::mesh::cases::lamp;
+        use crate::mesh::{Parameter, Scene};
+        let motions = [
+            Motion::TranslateX,
+            Motion::TranslateZ,
+            Motion::Rotate {
+                axis: DVec3::new(1.0, 1.0, 0.0).normalize(),
+                pivot: None,
+            },
+        ];
+        let parameters = motions
+            .iter()
+            .enumerate()
+            .map(|(j, &motion)| Parameter {
+                name: format!("p{j}"),
+                shape: "lamp".into(),
+                motion,
+                bounds: None,
+            })
+            .collect();
+        let sensor = crate::mesh::Sensor::Irradiance {
+            point: DVec3::new(0.3, 0.0, 0.5),
+            normal: DVec3::new(0.2, 0.0, 1.0),
+        };
+        let scene = Scene::new(vec![lamp()], parameters, sensor).unwrap();
+        let r = Reference::for_scene(&scene).unwrap();
+        let (x, n) = (DVec3::new(0.3, 0.0, 0.5), DVec3::new(0.2, 0.0, 1.0));
+        let corners = lamp().vertices;
+        close(
+            r.value(),
+            polygon_irradiance(x, n, &corners, 1.0).unwrap(),
+            1e-12,
+            "E",
+        );
+        for j in 0..motions.len() {
+            // Pivots resolved (the lamp's centroid).
+            let m = scene.parameters()[j].motion;
+            let e = |h: f64| {
+                let q: Vec<DVec3> = corners.iter().map(|&q| m.apply(q, h)).collect();
+                polygon_irradiance(x, n, &q, 1.0).unwrap()
+            };
+            close(r.derivative(j), richardson(&e, 1e-3), 1e-7, "dE/dπ");
+        }
+    }
+
+    #[test]
+    fn scenes_without_a_closed_form_say_why() {
+        for (name, why) in [
+            ("fog_cube.toml", "reflectors and media"),
+            ("camera_shadow.toml", "camera"),
+            ("dome.toml", ""),
+            ("room.toml", ""),
+        ] {
+            let e = Reference::for_scene(&shipped(name))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("no analytic reference") && e.contains(why),
+                "{name}: {e}"
+            );
+        }
+        use crate::mesh::cases::{lamp, square_shape, up};
+        let above = square_shape(
+            "occ",
+            DVec3::new(0.0, 0.0, 2.5),
+            0.2,
+            crate::mesh::Surface::Absorber,
+        );
+        let scene = crate::mesh::Scene::new(vec![lamp(), above], Vec::new(), up()).unwrap();
+        let e = Reference::for_scene(&scene).unwrap_err().to_string();
+        assert!(
+            e.contains("no analytic reference") && e.contains("strictly between"),
+            "{e}"
+        );
     }
 }
