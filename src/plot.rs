@@ -29,6 +29,8 @@ pub enum Mark {
     Thin(Vec<(f64, f64)>),
     /// Hollow circles at `(x, y)`.
     Circles(Vec<(f64, f64)>),
+    /// Filled circles at `(x, y)`, as large as [`Mark::Circles`].
+    Dots(Vec<(f64, f64)>),
     /// Hollow triangles at `(x, y)`, pointing up where the flag is set and
     /// down where not: values beyond a clamped axis, drawn at the clamp.
     Triangles(Vec<(f64, f64, bool)>),
@@ -109,6 +111,15 @@ impl Series {
         }
     }
 
+    /// Filled circles as large as [`Series::circles`].
+    pub fn dots(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Dots(xy),
+        }
+    }
+
     /// Hollow circles.
     pub fn circles(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
         Series {
@@ -141,6 +152,7 @@ impl Series {
                     _ => vec![],
                 }),
                 Mark::Circles(_) => Mark::Circles(vec![]),
+                Mark::Dots(_) => Mark::Dots(vec![]),
                 Mark::Triangles(_) => Mark::Triangles(vec![]),
                 Mark::Thin(_) => Mark::Thin(vec![]),
                 Mark::Dashed(_) => Mark::Dashed(vec![]),
@@ -285,6 +297,7 @@ fn bounds(p: &Panel) -> ((f64, f64), (f64, f64)) {
             | Mark::Dashes(v)
             | Mark::Thin(v)
             | Mark::Circles(v)
+            | Mark::Dots(v)
             | Mark::Polygon { vertices: v, .. } => v.iter().for_each(|&(x, y)| {
                 xs.push(axis(x, p.x_log));
                 ys.push(axis(y, p.y_log));
@@ -460,6 +473,7 @@ impl Glyph {
         match mark {
             Mark::Polygon { opacity, .. } => Glyph::Fill(opacity.max(0.3)),
             Mark::Circles(_) => Glyph::Ring,
+            Mark::Dots(_) => Glyph::Dot,
             Mark::Triangles(_) => Glyph::Triangles,
             Mark::Points(v) if !v.is_empty() && v.iter().all(|p| p.2 == 0.0) => Glyph::Dot,
             Mark::Points(_) => Glyph::Estimate,
@@ -529,10 +543,10 @@ fn legend_rows(entries: &[Entry], size: u32, width: i32) -> Rows {
     rows
 }
 
-/// A hollow triangle of [`Mark::Triangles`] centred at `c` (pixels),
-/// pointing up or down.
-fn triangle(c: (i32, i32), up: bool, color: RGBColor) -> PathElement<(i32, i32)> {
-    let (r, s) = (7, if up { -1 } else { 1 });
+/// A hollow triangle of [`Mark::Triangles`] centred at `c` (pixels), `r`
+/// from its centre to its tip, pointing up or down.
+fn triangle(c: (i32, i32), r: i32, up: bool, color: RGBColor) -> PathElement<(i32, i32)> {
+    let s = if up { -1 } else { 1 };
     let tip = (c.0, c.1 + s * r);
     PathElement::new(
         vec![
@@ -584,8 +598,8 @@ fn draw_entry<DB: DrawingBackend>(
             }),
         Glyph::Ring => area.draw(&Circle::new((mid, y), 6, c.stroke_width(2))),
         Glyph::Triangles => area
-            .draw(&triangle((mid - 7, y), true, c))
-            .and_then(|_| area.draw(&triangle((mid + 7, y), false, c))),
+            .draw(&triangle((mid - 7, y), 6, true, c))
+            .and_then(|_| area.draw(&triangle((mid + 7, y), 6, false, c))),
         Glyph::Estimate => area
             .draw(&PathElement::new(
                 vec![(mid, y - 8), (mid, y + 8)],
@@ -703,7 +717,7 @@ fn drawn_points(panel: &Panel) -> Vec<(f64, f64)> {
                 }
                 continue;
             }
-            Mark::Circles(v) => {
+            Mark::Circles(v) | Mark::Dots(v) => {
                 v.iter().for_each(|&(x, y)| push(x, y));
                 continue;
             }
@@ -915,10 +929,17 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
                         .map(|c| Circle::new(c, 6, color.stroke_width(2))),
                 )
                 .map(|_| ()),
+            Mark::Dots(v) => chart
+                .draw_series(
+                    v.iter()
+                        .filter_map(to_axis)
+                        .map(|c| Circle::new(c, 6, color.filled())),
+                )
+                .map(|_| ()),
             Mark::Triangles(v) => chart
                 .draw_series(v.iter().filter_map(|&(x, y, up)| {
                     let c = to_axis(&(x, y))?;
-                    Some(EmptyElement::at(c) + triangle((0, 0), up, color))
+                    Some(EmptyElement::at(c) + triangle((0, 0), 7, up, color))
                 }))
                 .map(|_| ()),
             Mark::Polygon { vertices, opacity } => {

@@ -115,13 +115,12 @@ fn panel(title: String, groups: &[String], records: &[Record], (lo, hi): (f64, f
             let x = g as f64 + offset;
             // Hollow: the variance estimate itself is unreliable.
             if r.vov < Estimate::VOV_LIMIT {
-                solid.push((x, r.work, 0.0));
+                solid.push((x, r.work));
             } else {
                 hollow.push((x, r.work));
             }
         }
-        series.push(Series::legend_dot(method.name(), color(method)));
-        series.push(Series::points("", color(method), solid));
+        series.push(Series::dots(method.name(), color(method), solid));
         series.push(Series::circles("", color(method), hollow));
     }
     series.push(Series::circles(
