@@ -1085,7 +1085,10 @@ fn tick(v: f64, log: bool) -> String {
     } else if v.abs() < 1e-2 || v.abs() >= 1e4 {
         format!("{v:.1e}")
     } else {
-        format!("{v:.4}")
+        // Four significant digits at least, so that ticks a quarter of a
+        // step apart (−0.03075, −0.0308) keep different labels.
+        let decimals = (3 - v.abs().log10().floor() as i32).max(4) as usize;
+        format!("{v:.decimals$}")
             .trim_end_matches('0')
             .trim_end_matches('.')
             .to_string()

@@ -108,10 +108,12 @@ struct PanelNumbers<'a> {
     series: Vec<(&'a str, &'a [Estimated])>,
 }
 
-/// Writes the figure (PNG, SVG) and the estimates it plots (JSON).
+/// Writes the figure, `columns` panels a row (PNG, SVG), and the estimates
+/// it plots (JSON).
 fn save_with_numbers(
     opts: &FigureOptions,
     mut panels: Vec<Panel>,
+    columns: usize,
     name: &str,
 ) -> Result<Vec<PathBuf>, Error> {
     let numbers: Vec<PanelNumbers> = panels
@@ -133,7 +135,7 @@ fn save_with_numbers(
     for s in panels.iter_mut().flat_map(|p| &mut p.series) {
         s.label.clear();
     }
-    let mut figure = Figure::new(panels, 2 * DIRECTIONS.len());
+    let mut figure = Figure::new(panels, columns);
     figure.legend = legend();
     figure.panel_size = (470, 360);
     let mut written = figure.save(&opts.out, name)?;
@@ -151,7 +153,8 @@ pub fn intensity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> 
     })?;
     bar.inc(1);
     bar.finish();
-    save_with_numbers(opts, panels, "intensity_along_rod")
+    // One rod a row: a strip of four would be too flat at the book's width.
+    save_with_numbers(opts, panels, DIRECTIONS.len(), "intensity_along_rod")
 }
 
 /// Fig. 6a–d: s against x for rendering, expectation and transport, and
@@ -175,5 +178,5 @@ pub fn sensitivity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error
         bar.inc(1);
     }
     bar.finish();
-    save_with_numbers(opts, panels, "sensitivity_along_rod")
+    save_with_numbers(opts, panels, 2 * DIRECTIONS.len(), "sensitivity_along_rod")
 }
