@@ -636,7 +636,7 @@ mod tests {
         let y = image_height + 2 * k + 2 * k;
         let row = px[y * width as usize..][..width as usize].to_vec();
         let below = &px[(image_height + 9 * k) * width as usize..];
-        let inked = below.iter().any(|&p| p == INK);
+        let inked = below.contains(&INK);
         assert!(height as usize > image_height + 9 * k);
         (row, inked)
     }
