@@ -7,9 +7,10 @@
 //! exact `f64` for NumPy) or as a picture ([`write_png_magnitude`] for
 //! values ≥ 0 such as `I` and standard errors; [`write_png_diverging`] for
 //! signed sensitivities). [`robust_scale`] picks a display range that a few
-//! outlier pixels cannot flatten; a PNG holds it in its text (`Scale`, and
-//! a `Description` of the map with [`scale_tag`]'s short form), so that its
-//! name need not change with it.
+//! outlier pixels cannot flatten; a PNG shows it in a colour bar under the
+//! image (the map over the range, with [`scale_tag`]'s numbers at its ends
+//! and at 0) and holds it in its text (`Scale`, and a `Description` of the
+//! map), so that its name need not change with it.
 //!
 //! Each `write_*` writes one file whole or not at all (through a temporary
 //! renamed when complete); each `add_*` writes one file of a
@@ -121,7 +122,10 @@ pub fn write_png_magnitude(path: &Path, plane: &Plane, max: f64) -> Result<(), E
 
 /// Writes `plane` into `set` as an 8-bit RGB PNG in the perceptual map
 /// viridis, from **0** (dark purple, `#440154`) to `max` (yellow,
-/// `#fde725`); its text gives `max` (`Scale`) and the map (`Description`).
+/// `#fde725`); a colour bar under the image labels `0` and `max`, and its
+/// text gives `max` (`Scale`) and the map (`Description`). The image keeps
+/// its pixels at the top left, 1:1; the canvas is wider than the image
+/// only when the bar's numbers need it (white on the right).
 ///
 /// The low end is 0, not the image's minimum, so that the images of one
 /// render (`I` and its standard error) read alike and a colour means the same
@@ -143,7 +147,12 @@ pub fn add_png_magnitude(
     } else {
         NO_RANGE.to_owned()
     };
-    add_png(set, path, plane, magnitude_map(max), (max, &legend))
+    let bar = if ranged(max) {
+        Bar::new((0.0, max), vec![(0.0, "0".into()), (max, scale_tag(max))])
+    } else {
+        Bar::no_range()
+    };
+    add_png(set, path, plane, magnitude_map(max), (max, &legend), &bar)
 }
 
 /// Whether a PNG's scale spans a range (else every finite pixel takes one
@@ -173,8 +182,9 @@ pub fn write_png_diverging(path: &Path, plane: &Plane, scale: f64) -> Result<(),
 }
 
 /// Writes `plane` into `set` as an 8-bit RGB PNG in the diverging map
-/// red–blue (ColorBrewer RdBu reversed; its text gives `scale` and the
-/// map): `+scale` and above are dark red (`#67001f`),
+/// red–blue (ColorBrewer RdBu reversed; a colour bar under the image labels
+/// `-scale`, `0` and `+scale`, and its text gives `scale` and the map, as
+/// [`add_png_magnitude`]'s): `+scale` and above are dark red (`#67001f`),
 /// `-scale` and below dark blue (`#053061`), 0 the neutral near-white middle
 /// (`#f7f7f7`). Colours are interpolated linearly between the map's 11 stops,
 /// as matplotlib's `RdBu_r` does (colorous's own continuous evaluation is a
@@ -197,7 +207,24 @@ pub fn add_png_diverging(
     } else {
         NO_RANGE.to_owned()
     };
-    add_png(set, path, plane, diverging_map(scale), (scale, &legend))
+    let bar = if ranged(scale) {
+        let labels = vec![
+            (-scale, format!("-{tag}")),
+            (0.0, "0".into()),
+            (scale, format!("+{tag}")),
+        ];
+        Bar::new((-scale, scale), labels)
+    } else {
+        Bar::no_range()
+    };
+    add_png(
+        set,
+        path,
+        plane,
+        diverging_map(scale),
+        (scale, &legend),
+        &bar,
+    )
 }
 
 /// The colour of a finite value in [`write_png_diverging`]'s map (red–blue
@@ -277,20 +304,162 @@ fn check(path: &Path, plane: &Plane) -> Result<(), Error> {
     Err(output_error(path, cause))
 }
 
+/// The colour bar drawn under a PNG's image: the map over the displayed
+/// range, with numbers at some of its values, so that the picture carries
+/// its own scale.
+#[derive(Debug, Clone, PartialEq)]
+struct Bar {
+    /// The values at the bar's left and right ends.
+    range: (f64, f64),
+    /// Values and their labels (digits, `.`, `-`, `+`, `e`).
+    labels: Vec<(f64, String)>,
+}
+
+impl Bar {
+    fn new(range: (f64, f64), labels: Vec<(f64, String)>) -> Bar {
+        Bar { range, labels }
+    }
+
+    /// The bar of a map without a range: one colour, labelled so.
+    fn no_range() -> Bar {
+        Bar::new((0.0, 1.0), vec![(0.5, "no range".into())])
+    }
+}
+
+/// Rows of the 5×7 pixel font of the colour bar's labels (bit 4 is the
+/// leftmost column); a character it lacks is drawn blank.
+fn glyph(c: char) -> [u8; 7] {
+    match c {
+        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
+        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
+        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
+        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
+        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
+        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
+        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
+        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
+        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
+        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
+        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
+        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
+        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
+        'e' => [0, 0, 0x0E, 0x11, 0x1F, 0x10, 0x0E],
+        'n' => [0, 0, 0x16, 0x19, 0x11, 0x11, 0x11],
+        'o' => [0, 0, 0x0E, 0x11, 0x11, 0x11, 0x0E],
+        'r' => [0, 0, 0x16, 0x19, 0x10, 0x10, 0x10],
+        'a' => [0, 0, 0x0E, 0x01, 0x0F, 0x11, 0x0F],
+        'g' => [0, 0x0F, 0x11, 0x11, 0x0F, 0x01, 0x0E],
+        _ => [0; 7],
+    }
+}
+
+/// Colour of the bar's text and ticks.
+const INK: [u8; 3] = [0x20, 0x20, 0x20];
+/// Colour around the image and the bar.
+const PAPER: [u8; 3] = [0xff, 0xff, 0xff];
+
+/// An RGB picture being drawn: the image, then its colour bar.
+struct Canvas {
+    width: usize,
+    height: usize,
+    rgb: Vec<u8>,
+}
+
+impl Canvas {
+    fn set(&mut self, x: usize, y: usize, c: [u8; 3]) {
+        if x < self.width && y < self.height {
+            let i = 3 * (y * self.width + x);
+            self.rgb[i..i + 3].copy_from_slice(&c);
+        }
+    }
+
+    /// `text` with its top left at `(x, y)`, each font pixel `k`×`k`.
+    fn text(&mut self, (x, y): (usize, usize), text: &str, k: usize) {
+        for (i, c) in text.chars().enumerate() {
+            for (row, bits) in glyph(c).into_iter().enumerate() {
+                for col in (0..5).filter(|col| bits & (0x10 >> col) != 0) {
+                    for (dx, dy) in (0..k).flat_map(|dx| (0..k).map(move |dy| (dx, dy))) {
+                        let px = x + (6 * i + col) * k + dx;
+                        self.set(px, y + row * k + dy, INK);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Width in pixels of `text` in the bar's font at `k` pixels per font pixel.
+fn text_width(text: &str, k: usize) -> usize {
+    (6 * text.chars().count()).saturating_sub(1) * k
+}
+
+/// The picture of a PNG: `plane`'s pixels (`pixel` of each value) at the top
+/// left, 1:1, and under them `bar` in `colour`, with its labels; the canvas
+/// is widened (white on the right) when the image is too narrow for them.
+fn picture(
+    plane: &Plane,
+    pixel: impl Fn(f64) -> [u8; 3],
+    colour: impl Fn(f64) -> [u8; 3],
+    bar: &Bar,
+) -> Canvas {
+    // Font pixels grow with the image, so that the numbers stay legible
+    // beside it without dwarfing a small one.
+    let k = (plane.width / 100).clamp(1, 4);
+    let pad = 2 * k;
+    let labels: usize = bar.labels.iter().map(|(_, t)| text_width(t, k)).sum();
+    let gaps = 4 * k * bar.labels.len().saturating_sub(1);
+    let width = plane.width.max(labels + gaps + 2 * pad);
+    let (bar_top, bar_h, tick) = (plane.height + 2 * k, 5 * k, 2 * k);
+    let text_top = bar_top + bar_h + tick + k;
+    let height = text_top + 7 * k + 2 * k;
+    let mut canvas = Canvas {
+        width,
+        height,
+        rgb: PAPER.repeat(width * height),
+    };
+    for (i, &v) in plane.data.iter().enumerate() {
+        canvas.set(i % plane.width, i / plane.width, pixel(v));
+    }
+    let (lo, hi) = bar.range;
+    let span = (width - 2 * pad) as f64;
+    let at = |v: f64| pad as f64 + span * (v - lo) / (hi - lo);
+    for x in pad..width - pad {
+        let c = colour(lo + (hi - lo) * (x - pad) as f64 / (span - 1.0).max(1.0));
+        for y in bar_top..bar_top + bar_h {
+            canvas.set(x, y, c);
+        }
+    }
+    for (v, text) in &bar.labels {
+        let x = at(*v).round().clamp(pad as f64, (width - pad - 1) as f64) as usize;
+        for dx in 0..k.min(width - x) {
+            for y in bar_top + bar_h..bar_top + bar_h + tick {
+                canvas.set(x + dx, y, INK);
+            }
+        }
+        // Centred on its tick, kept inside the canvas.
+        let w = text_width(text, k);
+        let last = width.saturating_sub(pad + w).max(pad);
+        canvas.text(
+            ((x.saturating_sub(w / 2)).clamp(pad, last), text_top),
+            text,
+            k,
+        );
+    }
+    canvas
+}
+
 /// Checks `plane`, maps every value to a colour and writes the PNG into
-/// `set`, with its scale and the map's description (`legend`) as text.
+/// `set`: the image with its colour `bar` under it, and its scale and the
+/// map's description (`legend`) as text.
 fn add_png(
     set: &mut FileSet,
     path: &Path,
     plane: &Plane,
     colour: impl Fn(f64) -> [u8; 3],
     (scale, legend): (f64, &str),
+    bar: &Bar,
 ) -> Result<(), Error> {
     check(path, plane)?;
-    let size = |n: usize, what: &str| {
-        u32::try_from(n).map_err(|_| output_error(path, format!("{what} {n} is too large for PNG")))
-    };
-    let (w, h) = (size(plane.width, "width")?, size(plane.height, "height")?);
     let pixel = |x: f64| {
         if x.is_finite() {
             colour(x)
@@ -298,7 +467,12 @@ fn add_png(
             NON_FINITE_RGB
         }
     };
-    let rgb: Vec<u8> = plane.data.iter().flat_map(|&x| pixel(x)).collect();
+    let canvas = picture(plane, pixel, &colour, bar);
+    let size = |n: usize, what: &str| {
+        u32::try_from(n).map_err(|_| output_error(path, format!("{what} {n} is too large for PNG")))
+    };
+    let (w, h) = (size(canvas.width, "width")?, size(canvas.height, "height")?);
+    let rgb = canvas.rgb;
     let png_error = |e: png::EncodingError| match e {
         png::EncodingError::IoError(e) => io_error(path, &e),
         e => output_error(path, e),
@@ -396,6 +570,16 @@ mod tests {
         assert!(read.eq(DATA.iter().map(|x| x.to_bits())));
     }
 
+    /// Decodes a PNG of `geosens render` and keeps its image, the top left
+    /// `w`×`h` pixels (the colour bar under it and any margin cut away).
+    fn image(path: &Path, w: usize, h: usize) -> Vec<[u8; 3]> {
+        let (width, height, px) = decode(path);
+        assert!(width as usize >= w && height as usize > h);
+        (0..h)
+            .flat_map(|y| px[y * width as usize..][..w].to_vec())
+            .collect()
+    }
+
     /// Decodes an 8-bit RGB PNG: (width, height, pixels).
     fn decode(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
         let file = std::io::BufReader::new(File::open(path).unwrap());
@@ -418,13 +602,13 @@ mod tests {
         let path = dir.0.join("d.png");
         let data = [0.0, 2.0, -2.0, 5.0, -5.0, NAN];
         write_png_diverging(&path, &plane(3, 2, &data), 2.0).unwrap();
-        let (w, h, px) = decode(&path);
-        assert_eq!((w, h), (3, 2));
         let (mid, red, blue) = ([0xf7, 0xf7, 0xf7], [0x67, 0x00, 0x1f], [0x05, 0x30, 0x61]);
+        let px = image(&path, 3, 2);
         assert_eq!(px, [mid, red, blue, red, blue, NON_FINITE_RGB]);
         for no_range in [0.0, -1.0, NAN, INF] {
             write_png_diverging(&path, &plane(3, 2, &data), no_range).unwrap();
-            assert_eq!(decode(&path).2, [mid, mid, mid, mid, mid, NON_FINITE_RGB]);
+            let px = image(&path, 3, 2);
+            assert_eq!(px, [mid, mid, mid, mid, mid, NON_FINITE_RGB]);
         }
     }
 
@@ -434,13 +618,60 @@ mod tests {
         let path = dir.0.join("i.png");
         let data = [0.0, 3.0, -1.0, 7.0, INF, 1.5];
         write_png_magnitude(&path, &plane(2, 3, &data), 3.0).unwrap();
-        let (w, h, px) = decode(&path);
-        assert_eq!((w, h), (2, 3));
         let (low, high) = ([0x44, 0x01, 0x54], [0xfd, 0xe7, 0x25]);
+        let px = image(&path, 2, 3);
         assert_eq!(px[..5], [low, high, low, high, NON_FINITE_RGB]);
         assert!(px[5] != low && px[5] != high);
         write_png_magnitude(&path, &plane(2, 3, &data), 0.0).unwrap();
-        assert_eq!(decode(&path).2, [low, low, low, low, NON_FINITE_RGB, low]);
+        let px = image(&path, 2, 3);
+        assert_eq!(px, [low, low, low, low, NON_FINITE_RGB, low]);
+    }
+
+    /// The colour bar's row of pixels through its middle and whether any
+    /// pixel under it is ink (its labels).
+    fn bar_row(path: &Path, image_height: usize) -> (Vec<[u8; 3]>, bool) {
+        let (width, height, px) = decode(path);
+        // Images under 100 pixels wide: one pixel per font pixel.
+        let k = 1;
+        let y = image_height + 2 * k + 2 * k;
+        let row = px[y * width as usize..][..width as usize].to_vec();
+        let below = &px[(image_height + 9 * k) * width as usize..];
+        let inked = below.contains(&INK);
+        assert!(height as usize > image_height + 9 * k);
+        (row, inked)
+    }
+
+    #[test]
+    fn pngs_carry_a_colour_bar_with_numbers() {
+        let dir = TempDir::new("bar");
+        let path = dir.0.join("b.png");
+        let data = [0.0, 1.0, 2.0, 3.0];
+        // A 2×2 image is widened for the labels; the bar runs over the map.
+        write_png_magnitude(&path, &plane(2, 2, &data), 3.0).unwrap();
+        let (row, inked) = bar_row(&path, 2);
+        let bar: Vec<_> = row.iter().filter(|&&p| p != PAPER).collect();
+        let (low, high) = ([0x44, 0x01, 0x54], [0xfd, 0xe7, 0x25]);
+        assert_eq!((*bar[0], *bar[bar.len() - 1]), (low, high));
+        assert!(bar.len() > 10 && inked);
+        write_png_diverging(&path, &plane(2, 2, &data), 3.0).unwrap();
+        let (row, inked) = bar_row(&path, 2);
+        let bar: Vec<_> = row.iter().filter(|&&p| p != PAPER).collect();
+        let (red, blue) = ([0x67, 0x00, 0x1f], [0x05, 0x30, 0x61]);
+        assert_eq!((*bar[0], *bar[bar.len() - 1]), (blue, red));
+        assert!(inked);
+        // A wide image keeps its width: the bar goes under it.
+        let wide = vec![1.0; 300 * 2];
+        write_png_magnitude(&path, &plane(300, 2, &wide), 1.0).unwrap();
+        assert_eq!(decode(&path).0, 300);
+    }
+
+    #[test]
+    fn the_font_draws_every_character_of_a_scale() {
+        for tag in ["-1.23e-2", "+9.87e6", "4.5e0", "no range"] {
+            for c in tag.chars().filter(|&c| c != ' ') {
+                assert!(glyph(c).iter().any(|&row| row != 0), "{c:?}");
+            }
+        }
     }
 
     #[test]

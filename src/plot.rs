@@ -19,8 +19,8 @@ pub enum Mark {
     Line(Vec<(f64, f64)>),
     /// A dashed polyline through `(x, y)`.
     Dashed(Vec<(f64, f64)>),
-    /// A thick dashed polyline: a curve that may lie on another one, which
-    /// then shows through its gaps.
+    /// A wide dashed polyline: a curve that may lie on another one. Drawn
+    /// before it, the other runs on top through its dashes, and both show.
     Dashes(Vec<(f64, f64)>),
     /// Points `(x, mean, σ)` with ±σ error bars.
     Points(Vec<(f64, f64, f64)>),
@@ -29,6 +29,11 @@ pub enum Mark {
     Thin(Vec<(f64, f64)>),
     /// Hollow circles at `(x, y)`.
     Circles(Vec<(f64, f64)>),
+    /// Filled circles at `(x, y)`, as large as [`Mark::Circles`].
+    Dots(Vec<(f64, f64)>),
+    /// Hollow triangles at `(x, y)`, pointing up where the flag is set and
+    /// down where not: values beyond a clamped axis, drawn at the clamp.
+    Triangles(Vec<(f64, f64, bool)>),
     /// A closed polygon through `vertices` (in data coordinates), outlined
     /// and filled with the series colour at `opacity` (in `[0, 1]`).
     Polygon {
@@ -79,7 +84,7 @@ impl Series {
         }
     }
 
-    /// A thick dashed line series (drawn over a line it may hide).
+    /// A wide dashed line series (drawn under a line it may lie on).
     pub fn dashes(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
         Series {
             label: label.into(),
@@ -106,12 +111,58 @@ impl Series {
         }
     }
 
+    /// Filled circles as large as [`Series::circles`].
+    pub fn dots(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Dots(xy),
+        }
+    }
+
     /// Hollow circles.
     pub fn circles(label: &str, color: usize, xy: Vec<(f64, f64)>) -> Series {
         Series {
             label: label.into(),
             color,
             mark: Mark::Circles(xy),
+        }
+    }
+
+    /// Hollow triangles at the clamp line of values beyond it (`up`:
+    /// beyond the top).
+    pub fn triangles(label: &str, color: usize, xyu: Vec<(f64, f64, bool)>) -> Series {
+        Series {
+            label: label.into(),
+            color,
+            mark: Mark::Triangles(xyu),
+        }
+    }
+
+    /// This series' legend entry alone: its label, colour and kind of mark
+    /// without data (it draws nothing), for a legend whose entries keep
+    /// their order while the data are drawn in another.
+    pub fn key(&self) -> Series {
+        Series {
+            label: self.label.clone(),
+            color: self.color,
+            mark: match &self.mark {
+                Mark::Points(_) => Mark::Points(match Glyph::of(&self.mark) {
+                    Glyph::Dot => vec![(f64::NAN, f64::NAN, 0.0)],
+                    _ => vec![],
+                }),
+                Mark::Circles(_) => Mark::Circles(vec![]),
+                Mark::Dots(_) => Mark::Dots(vec![]),
+                Mark::Triangles(_) => Mark::Triangles(vec![]),
+                Mark::Thin(_) => Mark::Thin(vec![]),
+                Mark::Dashed(_) => Mark::Dashed(vec![]),
+                Mark::Dashes(_) => Mark::Dashes(vec![]),
+                Mark::Line(_) => Mark::Line(vec![]),
+                Mark::Polygon { opacity, .. } => Mark::Polygon {
+                    vertices: vec![],
+                    opacity: *opacity,
+                },
+            },
         }
     }
 
@@ -246,6 +297,7 @@ fn bounds(p: &Panel) -> ((f64, f64), (f64, f64)) {
             | Mark::Dashes(v)
             | Mark::Thin(v)
             | Mark::Circles(v)
+            | Mark::Dots(v)
             | Mark::Polygon { vertices: v, .. } => v.iter().for_each(|&(x, y)| {
                 xs.push(axis(x, p.x_log));
                 ys.push(axis(y, p.y_log));
@@ -255,6 +307,10 @@ fn bounds(p: &Panel) -> ((f64, f64), (f64, f64)) {
                 ys.push(axis(m - e, p.y_log));
                 ys.push(axis(m + e, p.y_log));
                 ys.push(axis(m, p.y_log));
+            }),
+            Mark::Triangles(v) => v.iter().for_each(|&(x, y, _)| {
+                xs.push(axis(x, p.x_log));
+                ys.push(axis(y, p.y_log));
             }),
         }
     }
@@ -305,6 +361,10 @@ pub fn diverging(t: f64) -> RGBColor {
     }
 }
 
+/// Width of [`Mark::Dashes`], in pixels: wide enough to show on both
+/// sides of a 2-pixel line drawn over it.
+const DASHES_WIDTH: u32 = 6;
+
 /// Margin around every chart, in pixels.
 const MARGIN: u32 = 12;
 /// Height of the x axis' label area, in pixels.
@@ -328,16 +388,37 @@ const ENTRY_GAP: i32 = 24;
 /// Distance of a corner legend from the chart's edges, in pixels.
 const LEGEND_INSET: i32 = 8;
 
-/// Height of a title's block (plotters draws a caption with half its
-/// height, at most 5 px, above and below).
-fn title_height(title: &str) -> u32 {
+/// Smallest font size a long title shrinks to.
+const MIN_TITLE_SIZE: u32 = 12;
+
+/// The font size of `title` in an area `width` pixels wide: the title size,
+/// or smaller for a title that would not fit between the margins (plotters
+/// centres a caption and cuts what overhangs at both ends).
+fn title_size(title: &str, width: u32) -> u32 {
+    let room = width.saturating_sub(2 * MARGIN);
+    let wide = |size: u32| {
+        ("sans-serif", size)
+            .into_font()
+            .box_size(title)
+            .map_or(0, |(w, _)| w)
+    };
+    (MIN_TITLE_SIZE..=TITLE_SIZE)
+        .rev()
+        .find(|&size| wide(size) <= room)
+        .unwrap_or(MIN_TITLE_SIZE)
+}
+
+/// Height of a title's block in an area `width` pixels wide (plotters
+/// draws a caption with half its height, at most 5 px, above and below).
+fn title_height(title: &str, width: u32) -> u32 {
     if title.is_empty() {
         return 0;
     }
-    let h = ("sans-serif", TITLE_SIZE)
+    let size = title_size(title, width);
+    let h = ("sans-serif", size)
         .into_font()
         .box_size(title)
-        .map_or(TITLE_SIZE, |(_, h)| h);
+        .map_or(size, |(_, h)| h);
     h + 2 * (h / 2).min(5)
 }
 
@@ -347,7 +428,7 @@ fn title_height(title: &str) -> u32 {
 fn plot_size((w, h): (u32, u32), title: &str, top_margin: u32) -> (f64, f64) {
     let pw = f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1));
     let ph = f64::from(
-        h.saturating_sub(MARGIN + top_margin + title_height(title) + X_LABEL_AREA)
+        h.saturating_sub(MARGIN + top_margin + title_height(title, w) + X_LABEL_AREA)
             .max(1),
     );
     (pw, ph)
@@ -379,6 +460,8 @@ enum Glyph {
     Fill(f64),
     /// A hollow circle.
     Ring,
+    /// Hollow triangles, one up and one down.
+    Triangles,
     /// A dot with an error bar: an estimate.
     Estimate,
     /// A dot: points without error bars.
@@ -390,11 +473,13 @@ impl Glyph {
         match mark {
             Mark::Polygon { opacity, .. } => Glyph::Fill(opacity.max(0.3)),
             Mark::Circles(_) => Glyph::Ring,
+            Mark::Dots(_) => Glyph::Dot,
+            Mark::Triangles(_) => Glyph::Triangles,
             Mark::Points(v) if !v.is_empty() && v.iter().all(|p| p.2 == 0.0) => Glyph::Dot,
             Mark::Points(_) => Glyph::Estimate,
             Mark::Thin(_) => Glyph::Line(1),
             Mark::Dashed(_) => Glyph::Dash(2),
-            Mark::Dashes(_) => Glyph::Dash(3),
+            Mark::Dashes(_) => Glyph::Dash(DASHES_WIDTH),
             Mark::Line(_) => Glyph::Line(3),
         }
     }
@@ -458,6 +543,22 @@ fn legend_rows(entries: &[Entry], size: u32, width: i32) -> Rows {
     rows
 }
 
+/// A hollow triangle of [`Mark::Triangles`] centred at `c` (pixels), `r`
+/// from its centre to its tip, pointing up or down.
+fn triangle(c: (i32, i32), r: i32, up: bool, color: RGBColor) -> PathElement<(i32, i32)> {
+    let s = if up { -1 } else { 1 };
+    let tip = (c.0, c.1 + s * r);
+    PathElement::new(
+        vec![
+            tip,
+            (c.0 - r, c.1 - s * r * 2 / 3),
+            (c.0 + r, c.1 - s * r * 2 / 3),
+            tip,
+        ],
+        color.stroke_width(2),
+    )
+}
+
 /// Draws `e`'s mark and label with the mark's left end at `(x, y)`
 /// (pixels of `area`; `y` is the row's middle).
 fn draw_entry<DB: DrawingBackend>(
@@ -496,6 +597,9 @@ fn draw_entry<DB: DrawingBackend>(
                 ))
             }),
         Glyph::Ring => area.draw(&Circle::new((mid, y), 6, c.stroke_width(2))),
+        Glyph::Triangles => area
+            .draw(&triangle((mid - 7, y), 6, true, c))
+            .and_then(|_| area.draw(&triangle((mid + 7, y), 6, false, c))),
         Glyph::Estimate => area
             .draw(&PathElement::new(
                 vec![(mid, y - 8), (mid, y + 8)],
@@ -613,8 +717,12 @@ fn drawn_points(panel: &Panel) -> Vec<(f64, f64)> {
                 }
                 continue;
             }
-            Mark::Circles(v) => {
+            Mark::Circles(v) | Mark::Dots(v) => {
                 v.iter().for_each(|&(x, y)| push(x, y));
+                continue;
+            }
+            Mark::Triangles(v) => {
+                v.iter().for_each(|&(x, y, _)| push(x, y));
                 continue;
             }
             Mark::Line(v) | Mark::Dashed(v) | Mark::Dashes(v) | Mark::Thin(v) => (v, false),
@@ -662,7 +770,7 @@ fn count_in_corner(
 }
 
 fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), Error> {
-    let title_style = ("sans-serif", TITLE_SIZE);
+    let title_style = ("sans-serif", title_size(&p.title, area.dim_in_pixel().0));
     if p.legend_only {
         let body = if p.title.is_empty() {
             area.clone()
@@ -702,7 +810,7 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
         let width = dim.0 as i32 - left - MARGIN as i32;
         let rows = legend_rows(&list, LEGEND_SIZE, width);
         let strip = rows.len() as i32 * row_height(LEGEND_SIZE) + LEGEND_PAD;
-        let head_title = title_height(&p.title) as i32;
+        let head_title = title_height(&p.title, dim.0) as i32;
         let (head, body) = area.split_vertically(MARGIN as i32 + head_title + strip);
         if !p.title.is_empty() {
             let style = title_style
@@ -794,9 +902,9 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
             Mark::Dashes(v) => chart
                 .draw_series(DashedLineSeries::new(
                     v.iter().filter_map(to_axis),
-                    9,
+                    10,
                     6,
-                    color.stroke_width(3),
+                    color.stroke_width(DASHES_WIDTH),
                 ))
                 .map(|_| ()),
             Mark::Points(v) => chart
@@ -820,6 +928,19 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
                         .filter_map(to_axis)
                         .map(|c| Circle::new(c, 6, color.stroke_width(2))),
                 )
+                .map(|_| ()),
+            Mark::Dots(v) => chart
+                .draw_series(
+                    v.iter()
+                        .filter_map(to_axis)
+                        .map(|c| Circle::new(c, 6, color.filled())),
+                )
+                .map(|_| ()),
+            Mark::Triangles(v) => chart
+                .draw_series(v.iter().filter_map(|&(x, y, up)| {
+                    let c = to_axis(&(x, y))?;
+                    Some(EmptyElement::at(c) + triangle((0, 0), 7, up, color))
+                }))
                 .map(|_| ()),
             Mark::Polygon { vertices, opacity } => {
                 let v: Vec<(f64, f64)> = vertices.iter().filter_map(to_axis).collect();
@@ -964,7 +1085,10 @@ fn tick(v: f64, log: bool) -> String {
     } else if v.abs() < 1e-2 || v.abs() >= 1e4 {
         format!("{v:.1e}")
     } else {
-        format!("{v:.4}")
+        // Four significant digits at least, so that ticks a quarter of a
+        // step apart (−0.03075, −0.0308) keep different labels.
+        let decimals = (3 - v.abs().log10().floor() as i32).max(4) as usize;
+        format!("{v:.decimals$}")
             .trim_end_matches('0')
             .trim_end_matches('.')
             .to_string()
@@ -989,25 +1113,7 @@ impl Figure {
         for p in &mut self.panels {
             for s in &mut p.series {
                 if !s.label.is_empty() && !self.legend.iter().any(|l| l.label == s.label) {
-                    self.legend.push(Series {
-                        label: s.label.clone(),
-                        color: s.color,
-                        mark: match s.mark {
-                            Mark::Points(_) => Mark::Points(match Glyph::of(&s.mark) {
-                                Glyph::Dot => vec![(f64::NAN, f64::NAN, 0.0)],
-                                _ => vec![],
-                            }),
-                            Mark::Circles(_) => Mark::Circles(vec![]),
-                            Mark::Thin(_) => Mark::Thin(vec![]),
-                            Mark::Dashed(_) => Mark::Dashed(vec![]),
-                            Mark::Dashes(_) => Mark::Dashes(vec![]),
-                            Mark::Line(_) => Mark::Line(vec![]),
-                            Mark::Polygon { opacity, .. } => Mark::Polygon {
-                                vertices: vec![],
-                                opacity,
-                            },
-                        },
-                    });
+                    self.legend.push(s.key());
                 }
                 s.label.clear();
             }

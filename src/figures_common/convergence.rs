@@ -8,7 +8,7 @@ use super::{METHODS, REFERENCE_COLOR, color};
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::method::{Method, Problem};
-use crate::plot::{Legend, Panel, Series, quiet_corner, spread};
+use crate::plot::{Legend, Mark, Panel, Series, quiet_corner, spread};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -146,8 +146,9 @@ pub(crate) fn panel(title: String, records: &[Record], parameter: &str) -> Panel
     panel
 }
 
-/// `method`'s σ against `x` as a line labelled `label` (dashed for
-/// transport: its σ lies on rendering's, which shows through) and its
+/// `method`'s σ against `x` as a line labelled `label` (wide dashes for
+/// transport: its σ often lies on rendering's, and [`layered`] draws it
+/// first, so rendering's line runs on top through its dashes) and its
 /// `(x, |mean − exact|, 0)` as dots.
 pub(crate) fn sigma_and_error(
     method: Method,
@@ -166,6 +167,25 @@ pub(crate) fn sigma_and_error(
     ]
 }
 
+/// `series` in a legend's order and a drawing order: first a key of every
+/// labelled series (as given), then the data, unlabelled, the wide dashes
+/// first so that a line lying on them is drawn on top and both show.
+pub(crate) fn layered(series: Vec<Series>) -> Vec<Series> {
+    let mut out: Vec<Series> = series
+        .iter()
+        .filter(|s| !s.label.is_empty())
+        .map(Series::key)
+        .collect();
+    let (under, over): (Vec<Series>, Vec<Series>) = series
+        .into_iter()
+        .partition(|s| matches!(s.mark, Mark::Dashes(_)));
+    out.extend(under.into_iter().chain(over).map(|mut s| {
+        s.label.clear();
+        s
+    }));
+    out
+}
+
 /// The dashed reference `c/√x` from `x = lo` to `hi`, labelled `label`:
 /// the rate of an unbiased finite-variance estimator.
 pub(crate) fn slope(label: &str, c: f64, (lo, hi): (f64, f64)) -> Series {
@@ -177,14 +197,14 @@ pub(crate) fn slope(label: &str, c: f64, (lo, hi): (f64, f64)) -> Series {
 }
 
 /// The log–log panel titled `title` of σ (lines) and |mean − exact| (dots)
-/// against `x_label`, drawing `series` after two legend entries that say
-/// what lines and dots are (they draw nothing).
+/// against `x_label`, drawing `series` ([`layered`]) after two legend
+/// entries that say what lines and dots are (they draw nothing).
 pub(crate) fn sigma_panel(title: String, x_label: &str, series: Vec<Series>) -> Panel {
     let mut all = vec![
         Series::line("σ (lines)", REFERENCE_COLOR, vec![]),
         Series::legend_dot("|mean − exact| (dots)", REFERENCE_COLOR),
     ];
-    all.extend(series);
+    all.extend(layered(series));
     Panel {
         title,
         x_label: x_label.into(),

@@ -1,6 +1,7 @@
-//! The `σ²·t` grouped bars of the flatland and 3D efficiency figures: every
-//! method ([`METHODS`]) timed on one thread on a few scenes, one panel of
-//! bars per scene, one group per quantity (`E` and every parameter).
+//! The `σ²·t` of the flatland and 3D efficiency figures: every method
+//! ([`METHODS`]) timed on one thread on a few scenes, one panel of markers
+//! per scene on a log axis, one group per quantity (`E` and every
+//! parameter).
 use super::{FigureOptions, run_method, save};
 use super::{METHODS, color};
 use crate::error::Error;
@@ -40,7 +41,8 @@ pub struct Record {
 /// Runs shorter than this (seconds) are repeated for a robust time.
 pub const MIN_SECONDS: f64 = 0.1;
 
-/// The top of the log axis over the largest bar, as a factor.
+/// The ends of the log axis beyond the smallest and largest value, as a
+/// factor.
 const HEADROOM: f64 = 2.0;
 
 /// What differs between the flatland and the 3D efficiency figure.
@@ -84,20 +86,22 @@ fn timed<S: Model>(
     Ok(best)
 }
 
-/// Palette index of the legend entry of pale bars (black, drawn grey).
-const PALE: usize = 6;
+/// Palette index of the legend entry of hollow markers (black).
+const HOLLOW: usize = 6;
 
-/// Half the width of a bar, in group units.
-const BAR: f64 = 0.075;
+/// Distance between two methods' markers in a group, in group units.
+const STEP: f64 = 0.15;
 
-/// The grouped-bar panel of one scene: groups `E` and the parameters,
-/// one bar per method that estimates the group's quantity.
-fn panel(title: String, groups: &[String], records: &[Record], floor: f64, top: f64) -> Panel {
+/// The panel of one scene: groups `E` and the parameters, one marker per
+/// method that estimates the group's quantity, side by side on a log axis
+/// from `lo` to `hi`. Markers, not bars: a bar's length on a log axis would
+/// be set by where the axis starts.
+fn panel(title: String, groups: &[String], records: &[Record], (lo, hi): (f64, f64)) -> Panel {
     let mut series = Vec::new();
     let k_mid = 0.5 * (METHODS.len() - 1) as f64;
     for (k, method) in METHODS.into_iter().enumerate() {
-        let offset = (k as f64 - k_mid) * 2.2 * BAR;
-        let mut first = true;
+        let offset = (k as f64 - k_mid) * STEP;
+        let (mut solid, mut hollow) = (Vec::new(), Vec::new());
         for (g, group) in groups.iter().enumerate() {
             let Some(r) = records
                 .iter()
@@ -109,36 +113,20 @@ fn panel(title: String, groups: &[String], records: &[Record], floor: f64, top: 
                 continue;
             }
             let x = g as f64 + offset;
-            let label = if first { method.name() } else { "" };
-            first = false;
-            // Pale: the variance estimate itself is unreliable.
-            let opacity = if r.vov < Estimate::VOV_LIMIT {
-                0.85
+            // Hollow: the variance estimate itself is unreliable.
+            if r.vov < Estimate::VOV_LIMIT {
+                solid.push((x, r.work));
             } else {
-                0.3
-            };
-            series.push(Series::polygon(
-                label,
-                color(method),
-                vec![
-                    (x - BAR, floor),
-                    (x + BAR, floor),
-                    (x + BAR, r.work),
-                    (x - BAR, r.work),
-                ],
-                opacity,
-            ));
+                hollow.push((x, r.work));
+            }
         }
-        if first {
-            // A legend entry even when the method drew no bar here.
-            series.push(Series::polygon(method.name(), color(method), vec![], 0.85));
-        }
+        series.push(Series::dots(method.name(), color(method), solid));
+        series.push(Series::circles("", color(method), hollow));
     }
-    series.push(Series::polygon(
-        &format!("pale: VOV ≥ {} (σ unreliable)", Estimate::VOV_LIMIT),
-        PALE,
+    series.push(Series::circles(
+        &format!("hollow: VOV ≥ {} (σ unreliable)", Estimate::VOV_LIMIT),
+        HOLLOW,
         vec![],
-        0.3,
     ));
     Panel {
         title: format!("{title}: σ²·t per quantity (1 thread; lower is better)"),
@@ -147,13 +135,13 @@ fn panel(title: String, groups: &[String], records: &[Record], floor: f64, top: 
         y_log: true,
         series,
         x_range: Some((-0.6, groups.len() as f64 - 0.4)),
-        y_range: Some((floor, top)),
+        y_range: Some((lo, hi)),
         x_tick_names: groups.to_vec(),
         ..Panel::default()
     }
 }
 
-/// Times every method on every scene of `spec`, draws the bars and writes
+/// Times every method on every scene of `spec`, draws the markers and writes
 /// `<prefix>_efficiency.{png,svg,json}`.
 pub(crate) fn efficiency<S: Model>(
     opts: &FigureOptions,
@@ -197,10 +185,9 @@ pub(crate) fn efficiency<S: Model>(
     let works = records.iter().map(|r| r.work).filter(|&w| w > 0.0);
     let lo = works.clone().fold(f64::INFINITY, f64::min);
     let hi = works.fold(0.0f64, f64::max);
-    let (floor, top) = if lo.is_finite() && hi > 0.0 {
-        // A decade at least half a decade under the smallest bar, so that
-        // every bar shows its height.
-        (10f64.powf((lo.log10() - 0.5).floor()), hi * HEADROOM)
+    // One axis for every panel, so that the scenes compare too.
+    let range = if lo.is_finite() && hi > 0.0 {
+        (lo / HEADROOM, hi * HEADROOM)
     } else {
         (1e-12, 1.0)
     };
@@ -214,7 +201,7 @@ pub(crate) fn efficiency<S: Model>(
                 .filter(|r| r.scene == name)
                 .cloned()
                 .collect();
-            panel((spec.title)(name), g, &rs, floor, top)
+            panel((spec.title)(name), g, &rs, range)
         })
         .collect();
     let mut figure = Figure::new(panels, 1).share_legend();

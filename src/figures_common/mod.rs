@@ -5,7 +5,7 @@
 //! rod at a probe), finding a parameter by name, the figure list runner,
 //! saving a figure with its numbers; and the experiments whose logic is the
 //! same on both kinds of scene (the sweeps against `π`, the convergence
-//! panel, whose pieces the rod's figures draw too, the `σ²·t` grouped bars,
+//! panel, whose pieces the rod's figures draw too, the `σ²·t` per quantity,
 //! the runs near singular configurations), parameterised by what differs.
 //! Nothing here depends on a dimension's scene types: a scene is a
 //! [`Model`] or a [`Problem`].

@@ -152,9 +152,26 @@ fn variance_panel(
     }
 }
 
+/// Where the bias panels clamp `(mean − exact)/σ`: a run beyond it is drawn
+/// as a hollow triangle on the clamp line (its JSON keeps the value).
+const CLAMP: f64 = 12.0;
+
+/// Palette index of the clamp's legend entry (black).
+const CLAMPED_COLOR: usize = REFERENCE_COLOR;
+
+/// The legend entry of the runs drawn at the clamp.
+fn clamped_key() -> Series {
+    Series::triangles(
+        &format!("|mean − exact|/σ > {CLAMP}: drawn at ±{CLAMP} (△ above, ▽ below)"),
+        CLAMPED_COLOR,
+        vec![],
+    )
+}
+
 /// The case's bias against the distance: `(mean − exact)/σ` with a bar of
-/// one, clamped to ±12, dashed lines at ±4, where every run has an exact
-/// value; the estimates themselves (`mean ± σ`) where not.
+/// one, dashed lines at ±4, where every run has an exact value, a run
+/// beyond ±[`CLAMP`] drawn as a hollow triangle on the clamp line; the
+/// estimates themselves (`mean ± σ`) where not.
 fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Record]) -> Panel {
     let mine: Vec<&Record> = records
         .iter()
@@ -167,21 +184,31 @@ fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Record]) -> P
     let n = DERIVATIVE_METHODS.len();
     let mut series = Vec::new();
     for (k, &m) in DERIVATIVE_METHODS.iter().enumerate() {
-        let pts = mine
-            .iter()
-            .filter(|r| r.method == m.name())
-            .filter_map(|r| {
-                let x = spread(r.distance, k, n, true, 0.0);
-                if has_exact {
-                    // z with a bar of one (the error bar in units of σ);
-                    // clamped to the panel so that a far-off point shows.
-                    r.z.map(|z| (x, z.clamp(-12.0, 12.0), 1.0))
-                } else {
-                    Some((x, r.mean, r.stderr))
-                }
-            })
+        let of_method = || mine.iter().filter(|r| r.method == m.name());
+        let x = |r: &Record| spread(r.distance, k, n, true, 0.0);
+        if !has_exact {
+            let pts = of_method().map(|r| (x(r), r.mean, r.stderr)).collect();
+            series.push(Series::points("", color(m), pts));
+            continue;
+        }
+        // z with a bar of one (the error bar in units of σ); a wrong
+        // estimate reporting σ = 0 is infinitely far.
+        let z_of = |r: &Record| {
+            r.z.or_else(|| Some((r.mean - r.exact?).signum() * f64::INFINITY))
+        };
+        let z = || of_method().filter_map(|r| Some((x(r), z_of(r)?)));
+        let inside = z()
+            .filter(|p| p.1.abs() <= CLAMP)
+            .map(|(x, z)| (x, z, 1.0))
             .collect();
-        series.push(Series::points("", color(m), pts));
+        series.push(Series::points("", color(m), inside));
+        let beyond: Vec<_> = z()
+            .filter(|p| p.1.abs() > CLAMP)
+            .map(|(x, z)| (x, CLAMP.copysign(z), z > 0.0))
+            .collect();
+        if !beyond.is_empty() {
+            series.push(Series::triangles("", color(m), beyond));
+        }
     }
     if has_exact {
         for y in [-4.0, 4.0] {
@@ -190,7 +217,7 @@ fn bias_panel(case: &str, axis: &str, derivative: &str, records: &[Record]) -> P
     }
     Panel {
         title: if has_exact {
-            "bias (mean − exact)/σ, clamped ±12; dashed ±4".into()
+            format!("bias (mean − exact)/σ; dashed ±4; △▽ beyond ±{CLAMP}")
         } else {
             "no closed form: the estimates, mean ± σ".into()
         },
@@ -232,6 +259,8 @@ where
             .map(|&(case, _, axis, ..)| bias_panel(case, axis, derivative, &records)),
     );
     let mut figure = Figure::new(panels, cases.len()).share_legend();
+    // Every case keeps the entry, clamped runs or not: one legend for all.
+    figure.legend.push(clamped_key());
     figure.panel_size = panel_size;
     save(opts, &format!("{prefix}_stability"), &figure, &records)
 }

@@ -9,7 +9,7 @@ use super::{FigureOptions, get, grid, run_method, z};
 use crate::error::Error;
 use crate::estimator::Quantity;
 use crate::method::{Method, Problem};
-use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
+use crate::plot::{Figure, Panel, Series};
 use indicatif::ProgressBar;
 use serde::Serialize;
 use std::sync::Arc;
@@ -60,9 +60,8 @@ pub(crate) struct Spec {
     pub paths: u64,
     /// Base of the seed salts.
     pub salt: u64,
-    /// A legend in every panel (else none: the figure's legend is the
-    /// caller's).
-    pub legends: bool,
+    /// The legend's label of the reference curves.
+    pub reference: &'static str,
 }
 
 /// One estimate at one value of `π`.
@@ -214,9 +213,8 @@ fn pieces(xy: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
 
 /// The markers of the panel of `quantity`: every method that estimates it,
 /// side by side (`step` is the spacing of the values of `π`) so that the
-/// error bars do not hide each other. Labelled by [`super::label`] when
-/// `labelled`.
-fn markers(quantity: &str, step: f64, labelled: bool, records: &[Record]) -> Vec<Series> {
+/// error bars do not hide each other.
+fn markers(quantity: &str, step: f64, records: &[Record]) -> Vec<Series> {
     let methods: Vec<Method> = if quantity == "E" {
         vec![Method::Intensity]
     } else {
@@ -230,38 +228,36 @@ fn markers(quantity: &str, step: f64, labelled: bool, records: &[Record]) -> Vec
             .filter(|r| r.method == method.name() && r.quantity == quantity)
             .map(|r| (r.pi + offset, r.mean, r.stderr))
             .collect();
-        let label = if labelled {
-            super::label(method)
-        } else {
-            String::new()
-        };
-        series.push(Series::points(&label, color(method), points));
+        series.push(Series::points("", color(method), points));
+    }
+    series
+}
+
+/// The figure's one legend, across its top (the same entries for every
+/// panel, where a legend per panel would move from corner to corner): the
+/// reference curve, labelled `reference`, and every method.
+fn legend(reference: &str) -> Vec<Series> {
+    let mut series = vec![Series::line(reference, REFERENCE_COLOR, vec![])];
+    for method in methods() {
+        series.push(Series::points(&super::label(method), color(method), vec![]));
     }
     series
 }
 
 /// The two panels of one sweep, `E` and `∂E/∂π`, each over its reference
-/// curve (jumps drawn as gaps); with a legend in a quiet corner when
-/// `labelled`.
-fn panels<C: Column>(sweep: &C, curve: &Curve, records: &[Record], labelled: bool) -> [Panel; 2] {
+/// curve (jumps drawn as gaps), without a legend of their own.
+fn panels<C: Column>(sweep: &C, curve: &Curve, records: &[Record]) -> [Panel; 2] {
     let (lo, hi) = sweep.range();
     let step = (hi - lo) / (VALUES - 1) as f64;
-    let corners = [
-        Legend::UpperRight,
-        Legend::UpperLeft,
-        Legend::LowerRight,
-        Legend::LowerLeft,
-    ];
     QUANTITIES.map(|(quantity, y_label)| {
         let ys = if quantity == "E" { &curve.e } else { &curve.de };
         let xy: Vec<(f64, f64)> = curve.pi.iter().copied().zip(ys.iter().copied()).collect();
-        let mut series = Vec::new();
-        for (i, piece) in pieces(&xy).into_iter().enumerate() {
-            let label = if labelled && i == 0 { "analytic" } else { "" };
-            series.push(Series::line(label, REFERENCE_COLOR, piece));
-        }
-        series.extend(markers(quantity, step, labelled, records));
-        let mut panel = Panel {
+        let mut series: Vec<Series> = pieces(&xy)
+            .into_iter()
+            .map(|piece| Series::line("", REFERENCE_COLOR, piece))
+            .collect();
+        series.extend(markers(quantity, step, records));
+        Panel {
             title: format!(
                 "{}: {} against {}",
                 sweep.title(),
@@ -272,11 +268,7 @@ fn panels<C: Column>(sweep: &C, curve: &Curve, records: &[Record], labelled: boo
             y_label: y_label.into(),
             series,
             ..Panel::default()
-        };
-        if labelled {
-            panel.legend = quiet_corner(&panel, &corners, (0.35, 0.3)).0;
         }
-        panel
     })
 }
 
@@ -302,7 +294,7 @@ where
     for sweep in sweeps {
         let c = curve(sweep, spec.curve_points)?;
         let r = measure(opts, spec, sweep, &mut salt, &bar)?;
-        let [e, de] = panels(sweep, &c, &r, spec.legends);
+        let [e, de] = panels(sweep, &c, &r);
         top.push(e);
         bottom.push(de);
         numbers.records.extend(r);
@@ -310,7 +302,9 @@ where
     }
     bar.finish();
     top.extend(bottom);
-    Ok((numbers, Figure::new(top, sweeps.len())))
+    let mut figure = Figure::new(top, sweeps.len());
+    figure.legend = legend(spec.reference);
+    Ok((numbers, figure))
 }
 
 #[cfg(test)]

@@ -1,8 +1,8 @@
 //! `geosens render`: every pixel of a camera scene's image, for `I` and for
 //! every parameter's sensitivity, with their standard-error images; float
 //! images (OpenEXR, `.npy`), PNGs (a perceptual map for `I` and the error
-//! images, a diverging map centred on 0 for each sensitivity, the scale in
-//! the PNG's text), and one JSON line whose means are the images' mean
+//! images, a diverging map centred on 0 for each sensitivity, a colour bar
+//! with the scale under the image, the scale in the PNG's text too), and one JSON line whose means are the images' mean
 //! pixel values. The files are written as one set (`file_set`): fixed
 //! names, so a rerun replaces them, and a failure leaves none of its own.
 use super::*;
@@ -116,7 +116,8 @@ fn write_image_set(result: &ImageResult, dir: &Path) -> Result<Vec<PathBuf>, Err
             add_npy(&mut set, &dir.join(format!("{name}.npy")), &plane)?;
             // The sensitivity on a diverging map (±scale), I and the error
             // images on a perceptual one (0 to scale); the scale in the
-            // PNG's text, not its name, so that a rerun replaces it.
+            // PNG's colour bar and text, not its name, so that a rerun
+            // replaces it.
             let png = dir.join(format!("{name}.png"));
             let scale = robust_scale(data);
             if name == stem && !matches!(q, Quantity::Intensity) {

@@ -120,7 +120,7 @@ pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         curve_points: CURVE_POINTS,
         paths: PATHS,
         salt: SALT,
-        legends: true,
+        reference: "analytic",
     };
     let (mut numbers, mut figure) = sweep::figure(opts, &spec, &sweeps)?;
     // This figure's JSON has never held the VOV.

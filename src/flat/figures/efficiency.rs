@@ -2,16 +2,16 @@
 //! (the variance of one path's weight times the seconds one path takes, on
 //! one thread; equal to the variance of the estimate one second of
 //! sampling leaves) of every method, for `E` and every parameter of
-//! `polygon_occluder.toml`, `fog.toml` and `three_shapes.toml`, as grouped
-//! bars on a log axis; lower is better. A path of every method estimates
+//! `polygon_occluder.toml`, `fog.toml` and `three_shapes.toml`, as markers
+//! side by side on a log axis; lower is better. A path of every method estimates
 //! `E` and all the scene's sensitivities at once, so `t` is the time of the
-//! whole path, and the bars of one method share it; finite differences pay
+//! whole path, and the markers of one method share it; finite differences pay
 //! two extra readings per parameter.
 //!
 //! Every timing run uses one thread whatever `opts.threads`; runs shorter
 //! than [`MIN_SECONDS`] are repeated (same seed) and the fastest time kept.
-//! Bars with `σ = 0` cannot be drawn on the log axis and are left out (the
-//! JSON keeps them); pale bars have a relative variance of the variance
+//! Values with `σ = 0` cannot be drawn on the log axis and are left out
+//! (the JSON keeps them); hollow markers have a relative variance of the variance
 //! (VOV) of at least [`Estimate::VOV_LIMIT`](crate::stats::Estimate::VOV_LIMIT): heavy tails, their `σ` and
 //! so their `σ²·t` are not to be trusted.
 use super::{FigureOptions, load};
@@ -34,7 +34,7 @@ pub const MAX_REPEATS: u32 = 5;
 const SALT: u64 = 60_000_000;
 
 /// `σ²·t` of every method for `E` and every parameter of the [`SCENES`]
-/// (one panel each, grouped bars), [`PATHS`] paths per run on one thread.
+/// (one panel each, markers per quantity), [`PATHS`] paths per run on one thread.
 /// Writes `flat_efficiency.{png,svg}` and `flat_efficiency.json`.
 pub fn efficiency(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let spec = Spec {

@@ -15,7 +15,7 @@ use crate::flat::Scene;
 use crate::flat::geometry::{NO_SEGMENT, direction, perp};
 use crate::flat::methods::sensor_warp;
 use crate::flat::space::Plane;
-use crate::plot::{Figure, Legend, Panel, Series, quiet_corner};
+use crate::plot::{Figure, Panel, Series};
 use glam::DVec2;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -32,13 +32,8 @@ pub const FAN: usize = 36;
 /// The parameters drawn as arrow fields, one scene panel each.
 pub const ARROWS: [&str; 3] = ["gamma_tx", "gamma_rotate", "lamp_tx"];
 
-/// Legend corners, in order of preference.
-const CORNERS: [Legend; 4] = [
-    Legend::UpperRight,
-    Legend::LowerLeft,
-    Legend::UpperLeft,
-    Legend::LowerRight,
-];
+/// The legend's label of the arrows.
+const ARROWS_LABEL: &str = "t·V(φ)·η⊥ where the ray hits (in its parameter's colour)";
 
 /// A corner the sensor sees in front of it: a knot of the field.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -126,7 +121,7 @@ fn curves_panel(warp: &Warp) -> Panel {
             .collect();
         series.push(Series::line(&f.parameter, i, xy));
     }
-    let mut panel = Panel {
+    Panel {
         title: format!(
             "{}.toml: the warp V(φ) of the sensor's directions",
             warp.scene
@@ -136,9 +131,7 @@ fn curves_panel(warp: &Warp) -> Panel {
         series,
         x_range: Some((0.0, 180.0)),
         ..Panel::default()
-    };
-    panel.legend = quiet_corner(&panel, &CORNERS, (0.3, 0.45)).0;
-    panel
+    }
 }
 
 /// A polyline drawing an arrow from `a` to `b` with a head `head` long.
@@ -219,11 +212,7 @@ fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel 
     for &(end, v) in &ends {
         let Some(v) = v else { continue };
         if v.length() * scale > 1e-4 * size {
-            let label = if labelled {
-                ""
-            } else {
-                "t·V(φ)·η⊥ where the ray hits"
-            };
+            let label = if labelled { "" } else { ARROWS_LABEL };
             labelled = true;
             series.push(Series::line(
                 label,
@@ -240,7 +229,6 @@ fn arrows_panel(plane: &Plane, j: usize, color: usize, knots: &[Knot]) -> Panel 
         y_label: "y".into(),
         series,
         equal_aspect: true,
-        legend: Legend::LowerLeft,
         ..Panel::default()
     };
     // Room for the arrows at the view's edge.
@@ -286,7 +274,14 @@ pub fn warp(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         let j = parameter(&scene, name)?;
         panels.push(arrows_panel(&plane, j, j, &warp.knots));
     }
-    let mut figure = Figure::new(panels, 2);
+    // One legend across the top: the panels' keys, the same in every
+    // panel, and the parameters' colours, which the arrows take.
+    let mut figure = Figure::new(panels, 2).share_legend();
+    for s in &mut figure.legend {
+        if s.label == ARROWS_LABEL {
+            s.color = REFERENCE_COLOR;
+        }
+    }
     figure.panel_size = (720, 560);
     save(opts, "flat_warp", &figure, &warp)
 }

@@ -16,13 +16,12 @@
 //! triangle's size `r₀(1 + π)`): the estimators differentiate a scale about
 //! the *current* size, `r ∂E/∂r`, so their estimates (and the closed form's)
 //! are divided by `1 + π`.
-use super::{FigureOptions, REFERENCE_COLOR, color, label};
+use super::FigureOptions;
 use crate::error::Error;
 use crate::figures_common::save;
 use crate::figures_common::sweep::{self, Column, Exact, Spec};
 use crate::mesh::Scene;
 use crate::mesh::cases::TriangleOccluder;
-use crate::plot::Series;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -117,19 +116,6 @@ impl Column for Sweep {
     }
 }
 
-/// The figure's legend: the closed form and every method.
-fn legend() -> Vec<Series> {
-    let mut series = vec![Series::line(
-        "closed form (black triangle at z = 1 under the unit lamp at z = 2)",
-        REFERENCE_COLOR,
-        vec![],
-    )];
-    for method in sweep::methods() {
-        series.push(Series::points(&label(method), color(method), vec![]));
-    }
-    series
-}
-
 /// `E` and `∂E/∂π` against `π` for the black triangle occluder's
 /// translation along x, rotation and scale ([`SWEEPS`], columns; `E` on the
 /// top row, `∂E/∂π` below, the legend across the top),
@@ -146,10 +132,9 @@ pub fn against_pi(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
         curve_points: CURVE_POINTS,
         paths: PATHS,
         salt: SALT,
-        legends: false,
+        reference: "closed form (black triangle at z = 1 under the unit lamp at z = 2)",
     };
     let (sweeps, mut figure) = sweep::figure(opts, &spec, &SWEEPS)?;
-    figure.legend = legend();
     figure.panel_size = (560, 440);
     let o = TriangleOccluder::NOMINAL;
     let numbers = AgainstPi {

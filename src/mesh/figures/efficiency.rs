@@ -1,18 +1,18 @@
 //! 3D speed against accuracy: the work-normalised variance `σ²·t` (the
 //! variance of one path's weight times the seconds one path takes on one
 //! thread; the variance one second of sampling leaves) of every method,
-//! finite differences included, for `E` and every parameter, as grouped
-//! bars on a log axis (lower is better). Scenes: the black triangle
+//! finite differences included, for `E` and every parameter, as markers
+//! side by side on a log axis (lower is better). Scenes: the black triangle
 //! occluder ([`TriangleOccluder::NOMINAL`], translation, rotation, scale),
 //! `scenes/mesh/cube_shadow.toml` (a black cube) and
 //! `scenes/mesh/fog_cube.toml` (a scattering fog cube), one panel each. A
 //! path estimates `E` and all the scene's sensitivities at once, so the
-//! bars of one method share its `t`; finite differences pay two extra
+//! markers of one method share its `t`; finite differences pay two extra
 //! readings per parameter.
 //!
 //! Every timing run uses one thread whatever `opts.threads`; runs shorter
 //! than [`MIN_SECONDS`] are repeated (same seed) and the fastest time kept.
-//! Pale bars have a VOV of at least [`Estimate::VOV_LIMIT`](crate::stats::Estimate::VOV_LIMIT) (σ unreliable).
+//! Hollow markers have a VOV of at least [`Estimate::VOV_LIMIT`](crate::stats::Estimate::VOV_LIMIT) (σ unreliable).
 use super::FigureOptions;
 use crate::error::Error;
 use crate::figures_common::efficiency::{self, Spec};
@@ -45,7 +45,7 @@ fn scene(name: &str) -> Result<Scene, Error> {
 }
 
 /// `σ²·t` of every method (finite differences included) for `E` and every
-/// parameter of the [`SCENES`] (one panel each, grouped bars, log axis),
+/// parameter of the [`SCENES`] (one panel each, markers per quantity, log axis),
 /// [`PATHS`] paths per run on one thread. Writes
 /// `mesh_efficiency.{png,svg,json}`:
 ///

@@ -3,7 +3,7 @@
 use super::{FigureOptions, exact_value, positions, thick, thin};
 use crate::error::Error;
 use crate::estimator::Quantity;
-use crate::plot::{Figure, Legend, Mark, Panel, Series};
+use crate::plot::{Figure, Mark, Panel, Series};
 use crate::rod::{Direction, Method, PARAMETER, Rod};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -11,68 +11,91 @@ use std::path::PathBuf;
 /// Paths per point of the along-the-rod figures (times the effort).
 pub const PATHS: u64 = 100_000;
 
+/// The directions, their labels and palette indices, in the panels' order.
 const DIRECTIONS: [(Direction, &str, usize); 2] = [
     (Direction::Right, "ω = +1", 0),
     (Direction::Left, "ω = −1", 1),
 ];
 
-/// One panel: `method`'s estimates of `q` at 21 positions, both directions,
-/// over the exact curves.
+/// The rods, in the panels' order.
+fn rods() -> [(Rod, &'static str); 2] {
+    [(thin(), "thin"), (thick(), "thick")]
+}
+
+/// The legend entries of every panel (one legend for the figure): the exact
+/// curve and the estimates of each direction.
+fn legend() -> Vec<Series> {
+    DIRECTIONS
+        .iter()
+        .flat_map(|&(_, label, color)| {
+            [
+                Series::line(&format!("exact, {label}"), color, vec![]),
+                Series::points(&format!("estimate ± σ, {label}"), color, vec![]),
+            ]
+        })
+        .collect()
+}
+
+/// One panel: `method`'s estimates of `q` at 21 positions in direction `k`
+/// of [`DIRECTIONS`] (one direction a panel, each on its own y axis: the
+/// two differ by a factor 15 on the thin rod), over the exact curve.
 fn panel(
     opts: &FigureOptions,
-    rod: Rod,
-    name: &str,
+    (rod, name): (Rod, &str),
     method: Method,
     q: &Quantity,
+    k: usize,
     salt: u64,
 ) -> Result<Panel, Error> {
+    let (omega, label, color) = DIRECTIONS[k];
     let xs = positions(&rod, 21);
     let fine = positions(&rod, 201);
-    let mut series = Vec::new();
-    for (k, &(omega, label, color)) in DIRECTIONS.iter().enumerate() {
-        let exact = fine
-            .iter()
-            .map(|&x| (x, exact_value(&rod, x, omega, q)))
-            .collect();
-        series.push(Series::line(&format!("exact, {label}"), color, exact));
-        let mut points = Vec::with_capacity(xs.len());
-        for (i, &x) in xs.iter().enumerate() {
-            let r = opts.run(
-                method,
-                rod,
-                x,
-                omega,
-                PATHS,
-                salt + 1000 * k as u64 + i as u64,
-            )?;
-            let e = r
-                .get(q)
-                .ok_or_else(|| Error::Output(format!("{} does not estimate {q}", method.name())))?;
-            points.push((x, e.mean, e.stderr));
-        }
-        series.push(Series::points(
-            &format!("{}, {label}", method.name()),
-            color,
-            points,
-        ));
+    let exact = fine
+        .iter()
+        .map(|&x| (x, exact_value(&rod, x, omega, q)))
+        .collect();
+    let mut points = Vec::with_capacity(xs.len());
+    for (i, &x) in xs.iter().enumerate() {
+        let r = opts.run(
+            method,
+            rod,
+            x,
+            omega,
+            PATHS,
+            salt + 1000 * k as u64 + i as u64,
+        )?;
+        let e = r
+            .get(q)
+            .ok_or_else(|| Error::Output(format!("{} does not estimate {q}", method.name())))?;
+        points.push((x, e.mean, e.stderr));
     }
     Ok(Panel {
-        title: format!(
-            "{name} rod (κs = {}, κe = {}): {q} by {}",
-            rod.ks,
-            rod.ke,
-            method.name()
-        ),
+        title: format!("{name} rod (κs = {}, κe = {}), {label}", rod.ks, rod.ke),
         x_label: "x".into(),
-        y_label: q.to_string(),
-        series,
-        legend: if q == &Quantity::Intensity {
-            Legend::UpperRight
-        } else {
-            Legend::UpperLeft
-        },
+        y_label: format!("{q} by {}", method.name()),
+        series: vec![
+            Series::line("", color, exact),
+            Series::points(&format!("{}, {label}", method.name()), color, points),
+        ],
         ..Panel::default()
     })
+}
+
+/// The panels of one row: `method`'s `q` on both rods, both directions,
+/// seeds from `salt` on per rod (`salt_of(i)` for rod `i`).
+fn row(
+    opts: &FigureOptions,
+    method: Method,
+    q: &Quantity,
+    salt_of: impl Fn(usize) -> u64,
+) -> Result<Vec<Panel>, Error> {
+    let mut panels = Vec::new();
+    for (i, rod) in rods().into_iter().enumerate() {
+        for k in 0..DIRECTIONS.len() {
+            panels.push(panel(opts, rod, method, q, k, salt_of(i))?);
+        }
+    }
+    Ok(panels)
 }
 
 /// `(x, mean, σ)` of one point.
@@ -85,10 +108,12 @@ struct PanelNumbers<'a> {
     series: Vec<(&'a str, &'a [Estimated])>,
 }
 
-/// Writes the figure (PNG, SVG) and the estimates it plots (JSON).
+/// Writes the figure, `columns` panels a row (PNG, SVG), and the estimates
+/// it plots (JSON).
 fn save_with_numbers(
     opts: &FigureOptions,
-    panels: Vec<Panel>,
+    mut panels: Vec<Panel>,
+    columns: usize,
     name: &str,
 ) -> Result<Vec<PathBuf>, Error> {
     let numbers: Vec<PanelNumbers> = panels
@@ -106,37 +131,36 @@ fn save_with_numbers(
         })
         .collect();
     let json = opts.write_json(name, &numbers)?;
-    let mut written = Figure::new(panels, 2).save(&opts.out, name)?;
+    // The labels name the JSON's series; the figure's one legend says it.
+    for s in panels.iter_mut().flat_map(|p| &mut p.series) {
+        s.label.clear();
+    }
+    let mut figure = Figure::new(panels, columns);
+    figure.legend = legend();
+    figure.panel_size = (470, 360);
+    let mut written = figure.save(&opts.out, name)?;
     written.push(json);
     Ok(written)
 }
 
 /// Fig. 5: right- and left-going intensity against x with ±σ error bars,
-/// thin and thick rods. Writes `intensity_along_rod.{png,svg}`.
+/// thin and thick rods, one panel per rod and direction. Writes
+/// `intensity_along_rod.{png,svg}`.
 pub fn intensity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
-    let bar = opts.bar(2, "intensity along the rod");
-    let mut panels = Vec::new();
-    for (i, (rod, name)) in [(thin(), "thin"), (thick(), "thick")]
-        .into_iter()
-        .enumerate()
-    {
-        panels.push(panel(
-            opts,
-            rod,
-            name,
-            Method::Intensity,
-            &Quantity::Intensity,
-            100_000 * i as u64,
-        )?);
-        bar.inc(1);
-    }
+    let bar = opts.bar(1, "intensity along the rod");
+    let panels = row(opts, Method::Intensity, &Quantity::Intensity, |i| {
+        100_000 * i as u64
+    })?;
+    bar.inc(1);
     bar.finish();
-    save_with_numbers(opts, panels, "intensity_along_rod")
+    // One rod a row: a strip of four would be too flat at the book's width.
+    save_with_numbers(opts, panels, DIRECTIONS.len(), "intensity_along_rod")
 }
 
 /// Fig. 6a–d: s against x for rendering, expectation and transport, and
-/// ∂xI from transport, each over the exact curves, thin and thick rods.
-/// Writes `sensitivity_along_rod.{png,svg}`.
+/// ∂xI from transport, each over the exact curves, thin and thick rods,
+/// one panel per rod and direction. Writes
+/// `sensitivity_along_rod.{png,svg}`.
 pub fn sensitivity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error> {
     let s = Quantity::sensitivity(PARAMETER);
     let g = Quantity::gradient("x");
@@ -146,18 +170,13 @@ pub fn sensitivity_along_rod(opts: &FigureOptions) -> Result<Vec<PathBuf>, Error
         (Method::Transport, &s),
         (Method::Transport, &g),
     ];
-    let bar = opts.bar(2 * rows.len() as u64, "sensitivity along the rod");
+    let bar = opts.bar(rows.len() as u64, "sensitivity along the rod");
     let mut panels = Vec::new();
     for (r, (method, q)) in rows.into_iter().enumerate() {
-        for (i, (rod, name)) in [(thin(), "thin"), (thick(), "thick")]
-            .into_iter()
-            .enumerate()
-        {
-            let salt = 200_000 + 100_000 * (2 * r + i) as u64;
-            panels.push(panel(opts, rod, name, method, q, salt)?);
-            bar.inc(1);
-        }
+        let salt_of = |i: usize| 200_000 + 100_000 * (2 * r + i) as u64;
+        panels.extend(row(opts, method, q, salt_of)?);
+        bar.inc(1);
     }
     bar.finish();
-    save_with_numbers(opts, panels, "sensitivity_along_rod")
+    save_with_numbers(opts, panels, 2 * DIRECTIONS.len(), "sensitivity_along_rod")
 }

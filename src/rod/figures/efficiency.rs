@@ -16,6 +16,7 @@ use super::convergence::{
 };
 use super::{FigureOptions, positions};
 use crate::error::Error;
+use crate::figures_common::convergence::layered;
 use crate::plot::{Figure, Panel, Series};
 use crate::rod::{Direction, Method};
 use serde::Serialize;
@@ -65,7 +66,7 @@ fn work_panel(title: String, records: &[Record]) -> Panel {
             color,
             xy.iter().map(|&(x, w)| (x, w, 0.0)).collect(),
         ));
-        // Dashed as in the error panels, where it lies on rendering.
+        // Wide dashes under rendering's line, as in the error panels.
         series.push(if method == Method::Transport {
             Series::dashes(&label, color, xy)
         } else {
@@ -77,7 +78,7 @@ fn work_panel(title: String, records: &[Record]) -> Panel {
         x_label: "x".into(),
         y_label: "σ²·t (t in seconds, 1 thread)".into(),
         y_log: true,
-        series,
+        series: layered(series),
         ..Panel::default()
     }
 }

@@ -244,10 +244,13 @@ fn panel(record: &Record, hs: &[f64]) -> Panel {
     ));
     Panel {
         title: format!(
-            "D_h = [I(length + h) − I(length − h)]/2h, two intensity runs of N = {:.0e} paths: thick rod, x = 1, ω = −1, exact s = {:.5}",
-            record.paths as f64, record.exact
+            "D_h = [I(length + h) − I(length − h)]/2h of two intensity runs: thick rod, x = 1, ω = −1, s = {:.5}",
+            record.exact
         ),
-        x_label: "half step h".into(),
+        x_label: format!(
+            "half step h (N = {:.0e} paths per run)",
+            record.paths as f64
+        ),
         y_label: "σ (lines), |D_h − exact s| (dots)".into(),
         x_log: true,
         y_log: true,

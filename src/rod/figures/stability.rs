@@ -311,7 +311,7 @@ fn panel(cells: &[&Cell], thicknesses: &[f64], title: String) -> Panel {
 fn legend(record: &Record) -> Panel {
     let mut bar = colour_bar(
         &format!(
-            "{} runs of {} paths per cell; grey: s = 0 (x = 0, ω = +1)",
+            "λ = κs/κe, the albedo; {} runs of {} paths per cell",
             record.runs, record.paths
         ),
         "colour: coverage, fraction of runs with |mean − s| ≤ 2σ (honest: 0.954)",
@@ -328,6 +328,13 @@ fn legend(record: &Record) -> Panel {
         ),
         Series::legend_dot("most runs flagged (VOV ≥ 0.1)", FLAGGED_COLOR),
         Series::legend_dot("most runs report σ = 0 (no weight drawn)", ZERO_COLOR),
+        // Black at this opacity on white is the heat map's grey (160).
+        Series::polygon(
+            "grey: s = 0 exactly (x = 0, ω = +1)",
+            FLAGGED_COLOR,
+            vec![],
+            0.373,
+        ),
     ]);
     bar
 }
@@ -346,10 +353,13 @@ fn method_figure(record: &Record, thicknesses: &[f64], method: Method) -> Figure
                 })
                 .collect();
             let going = match omega {
-                Direction::Left => "−1, left-going",
-                Direction::Right => "+1, right-going",
+                Direction::Left => "−1 (left-going)",
+                Direction::Right => "+1 (right-going)",
             };
-            let title = format!("{}: ω = {going}, λ = {albedo}", method.name());
+            let title = format!(
+                "{}: ω = {going}, albedo λ = κs/κe = {albedo}",
+                method.name()
+            );
             panels.push(panel(&of_panel, thicknesses, title));
         }
     }
