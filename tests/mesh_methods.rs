@@ -1068,12 +1068,21 @@ fn edges_aligned_from_the_sensor_are_a_caveat_for_every_method() {
         triangles: s.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(),
         ..s
     };
+    // A reflecting ball: each of its edges is a discontinuity from
+    // everywhere, so its 1 920 planes outnumber the occluder's by far and
+    // each moved edge scans them rather than sorting them all.
+    let shiny = Shape {
+        surface: Surface::Reflector { albedo: 0.5 },
+        ..ball.clone()
+    };
     for (dx, tied, others) in [
         (0.0, true, vec![]),
         (1e-7, false, vec![]),
         (0.0, true, vec![ball.clone()]),
         (1e-7, false, vec![ball.clone()]),
         (0.0, true, vec![mirrored(ball.clone())]),
+        (0.0, true, vec![shiny.clone()]),
+        (1e-7, false, vec![shiny.clone()]),
     ] {
         let parameters = params("occ", &[("occ_tx", Motion::TranslateX)]);
         let occ = if others.iter().any(|o| o.vertices[0].x < 0.0) {

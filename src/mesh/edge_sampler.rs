@@ -139,9 +139,9 @@ impl EdgeTables {
 }
 
 /// The space's edge caches that depend on the sensor, each built on first
-/// use (the edge tables themselves are the scene's: see
-/// [`Scene`](super::scene::Scene)): only the derivative methods ask (not the intensity estimator, nor the displaced scenes of
-/// finite differences).
+/// use (the edge tables themselves are the scene's: see [`Scene`]): only
+/// the derivative methods ask (not the intensity estimator, nor the
+/// displaced scenes of finite differences).
 #[derive(Debug, Clone)]
 pub struct EdgeSampler {
     /// The moving edges each camera pixel sees (built on first use, by the

@@ -50,13 +50,23 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
     let key_axis = glam::DVec3::new(0.5773, 0.6181, -0.5331).normalize();
     let mut planes: Vec<(f64, usize)> = Vec::with_capacity(seen.len());
     let mut widest = 0.0f64;
+    let mut moved_planes = 0;
     for &i in &seen {
         if let Some((n, slack)) = plane(i) {
             planes.push((n.dot(key_axis), i));
             widest = widest.max(slack);
+            moved_planes += usize::from(moved(t.edges[i].shape));
         }
     }
-    planes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Few moved edges among many (a small moving occluder beside a large
+    // reflector, all of whose edges are seen): a scan of the keys per moved
+    // edge costs less than sorting them all, and finds the same candidates
+    // in the same order (sorted stably by key, as the whole list would be).
+    let scan = moved_planes * 64 < planes.len();
+    if !scan {
+        planes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    let mut window: Vec<(f64, usize)> = Vec::new();
     // (moved mesh, other mesh, the plane's unit normal, the moved edge's ends)
     let mut tied: Vec<(u32, u32, glam::DVec3, [glam::DVec3; 2])> = Vec::new();
     for &i in seen.iter().filter(|&&i| moved(t.edges[i].shape)) {
@@ -86,8 +96,18 @@ pub fn edge_ties(space: &Space) -> Vec<(Quantity, String)> {
         let arc_a = arc(ra, rb);
         let reach = slack + widest;
         for key in [unit.dot(key_axis), -unit.dot(key_axis)] {
-            let from = planes.partition_point(|p| p.0 < key - reach);
-            for &(_, k) in planes[from..].iter().take_while(|p| p.0 <= key + reach) {
+            let near = |p: &(f64, usize)| p.0 >= key - reach && p.0 <= key + reach;
+            let candidates = if scan {
+                window.clear();
+                window.extend(planes.iter().copied().filter(near));
+                window.sort_by(|a, b| a.0.total_cmp(&b.0));
+                &window[..]
+            } else {
+                let from = planes.partition_point(|p| p.0 < key - reach);
+                let to = from + planes[from..].partition_point(|p| p.0 <= key + reach);
+                &planes[from..to]
+            };
+            for &(_, k) in candidates {
                 let b = &t.edges[k];
                 // Within one mesh, edges that meet at a vertex are one
                 // outline (a face seen edge-on is `kinks`'s); apart, they

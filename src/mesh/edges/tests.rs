@@ -34,30 +34,7 @@ fn an_edge_is_drawn_with_the_probability_reported() {
     }
     let tree = EdgeTree::new(&edges, &facts, &weights, (0..200).collect());
     for x in [DVec3::new(0.1, -0.2, -1.0), DVec3::new(0.3, 0.2, 1.0)] {
-        let n = 400_000;
-        let mut drawn: Vec<(u32, f64)> = vec![(0, 0.0); 200];
-        for k in 0..n {
-            let u = (k as f64 + 0.5) / n as f64;
-            let (e, p, rest) = tree.sample(x, u, &edges, &facts, &weights).unwrap();
-            assert!((0.0..1.0).contains(&rest));
-            let slot = &mut drawn[e as usize];
-            if slot.0 > 0 {
-                assert_eq!(slot.1, p, "edge {e}: one probability per edge");
-            }
-            *slot = (slot.0 + 1, p);
-        }
-        let total: f64 = drawn.iter().map(|d| d.1).sum();
-        assert!((total - 1.0).abs() < 1e-12, "Σ p = {total}");
-        for (e, &(count, p)) in drawn.iter().enumerate() {
-            // The grid of u is stratified: an edge's count is its
-            // share of [0, 1) to within the strata its ends cut, a few
-            // per level of the tree.
-            let share = count as f64 / n as f64;
-            assert!(
-                (share - p).abs() < 40.0 / n as f64,
-                "edge {e}: {share} against {p}"
-            );
-        }
+        let drawn = draws_as_reported(&tree, &edges, &facts, &weights, x);
         // Nearer edges are drawn more often than far ones, per unit
         // weight: the distance enters.
         let mut by_distance: Vec<(f64, f64)> = edges
@@ -211,28 +188,8 @@ fn a_tree_joined_from_meshes_draws_as_it_reports() {
     order.sort_unstable();
     assert_eq!(order, (0..200).collect::<Vec<u32>>());
     for x in [DVec3::new(0.1, -0.2, -1.0), DVec3::new(1.3, 0.2, 1.0)] {
-        let n = 400_000;
-        let mut drawn: Vec<(u32, f64)> = vec![(0, 0.0); 200];
-        for k in 0..n {
-            let u = (k as f64 + 0.5) / n as f64;
-            let (e, p, rest) = tree.sample(x, u, &edges, &facts, &weights).unwrap();
-            assert!((0.0..1.0).contains(&rest));
-            let slot = &mut drawn[e as usize];
-            if slot.0 > 0 {
-                assert_eq!(slot.1, p, "edge {e}: one probability per edge");
-            }
-            *slot = (slot.0 + 1, p);
-        }
-        let total: f64 = drawn.iter().map(|d| d.1).sum();
-        assert!((total - 1.0).abs() < 1e-12, "Σ p = {total}");
-        for (e, &(count, p)) in drawn.iter().enumerate() {
-            assert!(count > 0, "edge {e} never drawn");
-            let share = count as f64 / n as f64;
-            assert!(
-                (share - p).abs() < 40.0 / n as f64,
-                "edge {e}: {share} against {p}"
-            );
-        }
+        let drawn = draws_as_reported(&tree, &edges, &facts, &weights, x);
+        assert!(drawn.iter().all(|d| d.0 > 0), "an edge is never drawn");
     }
     // One mesh joined alone: the tree over its edges, numbered in the scene.
     let alone = EdgeTree::join(&[(&local[2], 80)], &edges, &facts, &weights);
@@ -246,4 +203,43 @@ fn a_tree_joined_from_meshes_draws_as_it_reports() {
             built.sample(x, u, &edges, &facts, &weights)
         );
     }
+}
+
+/// Draws from `tree` at `x` with a fine grid of `u` over every edge (all
+/// always discontinuities, so every draw succeeds): each edge is drawn
+/// with one probability, the probabilities sum to 1, and each edge's share
+/// of the draws is its probability. Returns per edge its draws and
+/// probability.
+fn draws_as_reported(
+    tree: &EdgeTree,
+    edges: &[Edge],
+    facts: &[EdgeFacts],
+    weights: &[f64],
+    x: DVec3,
+) -> Vec<(u32, f64)> {
+    let n = 400_000;
+    let mut drawn: Vec<(u32, f64)> = vec![(0, 0.0); edges.len()];
+    for k in 0..n {
+        let u = (k as f64 + 0.5) / n as f64;
+        let (e, p, rest) = tree.sample(x, u, edges, facts, weights).unwrap();
+        assert!((0.0..1.0).contains(&rest));
+        let slot = &mut drawn[e as usize];
+        if slot.0 > 0 {
+            assert_eq!(slot.1, p, "edge {e}: one probability per edge");
+        }
+        *slot = (slot.0 + 1, p);
+    }
+    let total: f64 = drawn.iter().map(|d| d.1).sum();
+    assert!((total - 1.0).abs() < 1e-12, "Σ p = {total}");
+    for (e, &(count, p)) in drawn.iter().enumerate() {
+        // The grid of u is stratified: an edge's count is its share of
+        // [0, 1) to within the strata its ends cut, a few per level of the
+        // tree.
+        let share = count as f64 / n as f64;
+        assert!(
+            (share - p).abs() < 40.0 / n as f64,
+            "edge {e}: {share} against {p}"
+        );
+    }
+    drawn
 }

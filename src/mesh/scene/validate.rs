@@ -128,23 +128,15 @@ impl Scene {
         // flattened onto itself more plainly than the fold it also is.
         let volume = orient(&mut shapes, &closed, None)?;
         check_self_crossings(&shapes, size, None)?;
-        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters, size)?;
         let parts = shapes.iter().map(|_| part_cell()).collect();
-        Scene {
+        let meshes = Meshes {
             shapes,
-            parameters,
-            parameter_shape,
-            sensor,
             closed,
             volume,
             parts,
-            tables: Default::default(),
-            solid: Vec::new(),
-            parent: Vec::new(),
-            sensor_medium: None,
             size,
-        }
-        .seen_from(sensor)
+        };
+        meshes.scene(&parameters, sensor)
     }
 
     /// This scene's meshes posed anew: `shapes` are its own, some moved
@@ -188,7 +180,6 @@ impl Scene {
         check_crossings(&shapes, size, only)?;
         let volume = orient(&mut shapes, &self.closed, Some((&moved, &self.volume)))?;
         check_self_crossings(&shapes, size, only)?;
-        let (parameters, parameter_shape) = resolve_parameters(&shapes, &parameters, size)?;
         let parts = (0..shapes.len())
             .map(|k| {
                 if moved[k] {
@@ -198,21 +189,14 @@ impl Scene {
                 }
             })
             .collect();
-        Scene {
+        let meshes = Meshes {
             shapes,
-            parameters,
-            parameter_shape,
-            sensor: self.sensor,
             closed: self.closed.clone(),
             volume,
             parts,
-            tables: Default::default(),
-            solid: Vec::new(),
-            parent: Vec::new(),
-            sensor_medium: None,
             size,
-        }
-        .seen_from(self.sensor)
+        };
+        meshes.scene(&parameters, self.sensor)
     }
 
     /// The same meshes and parameters seen by `sensor`, validated as
@@ -239,6 +223,40 @@ impl Scene {
         self.parent = parent;
         self.sensor_medium = sensor_medium;
         Ok(self)
+    }
+}
+
+/// Validated meshes with what was learnt of them: closedness, enclosed
+/// volumes, their tables, the scene's size.
+struct Meshes {
+    shapes: Vec<Shape>,
+    closed: Vec<bool>,
+    volume: Vec<f64>,
+    parts: Vec<crate::mesh::part::PartCell>,
+    size: f64,
+}
+
+impl Meshes {
+    /// The scene of these meshes with `parameters` resolved against them,
+    /// seen by `sensor`.
+    fn scene(self, parameters: &[Parameter], sensor: Sensor) -> Result<Scene, Error> {
+        let (parameters, parameter_shape) =
+            resolve_parameters(&self.shapes, parameters, self.size)?;
+        Scene {
+            shapes: self.shapes,
+            parameters,
+            parameter_shape,
+            sensor,
+            closed: self.closed,
+            volume: self.volume,
+            parts: self.parts,
+            tables: Default::default(),
+            solid: Vec::new(),
+            parent: Vec::new(),
+            sensor_medium: None,
+            size: self.size,
+        }
+        .seen_from(sensor)
     }
 }
 
