@@ -18,6 +18,18 @@ else:  # pragma: no cover
     tomllib = pytest.importorskip("tomli")
 
 
+def cli_warnings(stderr: str) -> list:
+    """The command line's warnings, each joined again from the lines it is
+    wrapped into (100 columns, continuation lines indented by two spaces)."""
+    out = []
+    for line in stderr.splitlines():
+        if line.startswith("warning: "):
+            out.append(line.removeprefix("warning: "))
+        elif line.startswith("  ") and out:
+            out[-1] += " " + line[2:]
+    return out
+
+
 def test_caveats_are_runtime_warnings(cli, tmp_path):
     # The occluder's corner 10⁻⁴ above the sensor: fd's default half step
     # carries it past the sensor's zenith both ways (tests/flat_core.rs).
@@ -33,7 +45,7 @@ def test_caveats_are_runtime_warnings(cli, tmp_path):
     p = cli.run("flat", "--scene", path, "--method", "fd", "--paths", 100_000, "--seed", 2,
                 "--json")
     assert_same(py, geosens.from_json(p.stdout))
-    want = [line.removeprefix("warning: ") for line in p.stderr.splitlines()]
+    want = cli_warnings(p.stderr)
     assert want and all("occluder_tx" in w or "occluder" in w for w in want)
     assert [str(w.message) for w in caught] == want
     assert all(w.category is RuntimeWarning for w in caught)
