@@ -440,6 +440,11 @@ w.onmessage = (ev) => {
 def speed(d, url, scene_json):
     d.get(url + "/rod.html")
     d.set_script_timeout(600)
+    # The page's widgets start on load, each in a worker of its own: the
+    # bench waits until they are idle, or it shares the cores with them.
+    wait(d, """const bs = [...document.querySelectorAll('.live-widget')];
+               return bs.length > 0 && bs.every(b => b.dataset.running === 'false');""",
+         600, "the page's widgets idle")
     rod = {"ks": 0.5, "ke": 1.0, "length": 2.0, "x": 0.7, "omega": 1.0}
     cases = [
         ("rod", {"rod": rod, "method": "expectation", "paths": 8_000_000, "seed": 1},
