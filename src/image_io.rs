@@ -406,9 +406,17 @@ fn picture(
     // beside it without dwarfing a small one.
     let k = (plane.width / 100).clamp(1, 4);
     let pad = 2 * k;
-    let labels: usize = bar.labels.iter().map(|(_, t)| text_width(t, k)).sum();
-    let gaps = 4 * k * bar.labels.len().saturating_sub(1);
-    let width = plane.width.max(labels + gaps + 2 * pad);
+    // The first label starts at the bar's left end, the last ends at its
+    // right end, a middle one is centred: room for a gap of 6 font pixels
+    // between neighbours ("−7.47e-2 0 +7.47e-2" under a 32-pixel image ran
+    // together with less).
+    let w: Vec<usize> = bar.labels.iter().map(|(_, t)| text_width(t, k)).collect();
+    let gap = 6 * k;
+    let labels = match w.as_slice() {
+        [a, m, b] => 2 * (*a).max(*b) + m + 2 * gap,
+        _ => w.iter().sum::<usize>() + gap * w.len().saturating_sub(1),
+    };
+    let width = plane.width.max(labels + 2 * pad);
     let (bar_top, bar_h, tick) = (plane.height + 2 * k, 5 * k, 2 * k);
     let text_top = bar_top + bar_h + tick + k;
     let height = text_top + 7 * k + 2 * k;
