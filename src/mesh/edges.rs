@@ -555,4 +555,4 @@ impl EdgeTree {
 }
 
 #[cfg(test)]
-mod tests;
+pub(super) mod tests;

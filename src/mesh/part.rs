@@ -176,13 +176,8 @@ mod tests {
                 })
                 .collect();
             let opaque_scan = TriangleBvh::linear(opaque.iter().map(|&i| space.tris[i]).collect());
-            let mut state = 5u64;
-            let mut next = || {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-            };
+            let mut uniform = crate::mesh::edges::tests::uniform(5);
+            let mut next = || uniform() * 2.0 - 1.0;
             let size = space.scene.size();
             let mut hits = 0;
             for n in 0..4000 {

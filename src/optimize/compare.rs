@@ -618,17 +618,25 @@ impl Row {
 
 /// `rows` as a plain-text table, columns padded.
 pub fn text_table(rows: &[Row]) -> String {
-    let cells: Vec<[String; 7]> = rows.iter().map(Row::cells).collect();
-    let width = |c: usize| {
-        cells
-            .iter()
-            .map(|r| r[c].chars().count())
-            .chain([COLUMNS[c].chars().count()])
-            .max()
-            .unwrap_or(0)
-    };
-    let widths: Vec<usize> = (0..7).map(width).collect();
-    let line = |r: &[String]| {
+    let cells: Vec<Vec<String>> = rows.iter().map(|r| r.cells().to_vec()).collect();
+    padded(&COLUMNS, &cells)
+}
+
+/// `cells` under `header` as plain text: each column padded to its widest
+/// cell, two spaces apart, no trailing spaces, the lines joined by
+/// newlines.
+pub fn padded(header: &[&str], cells: &[Vec<String>]) -> String {
+    let widths: Vec<usize> = (0..header.len())
+        .map(|c| {
+            cells
+                .iter()
+                .map(|r| r[c].chars().count())
+                .chain([header[c].chars().count()])
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let line = |r: &[&str]| {
         r.iter()
             .zip(&widths)
             .map(|(c, &w)| format!("{c:<w$}"))
@@ -637,13 +645,13 @@ pub fn text_table(rows: &[Row]) -> String {
             .trim_end()
             .to_string()
     };
-    let head: Vec<String> = COLUMNS.iter().map(|c| c.to_string()).collect();
-    let mut out = line(&head);
-    for r in &cells {
-        out.push('\n');
-        out.push_str(&line(r));
-    }
-    out
+    let body = cells
+        .iter()
+        .map(|r| line(&r.iter().map(String::as_str).collect::<Vec<_>>()));
+    std::iter::once(line(header))
+        .chain(body)
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// `rows` as a markdown table.

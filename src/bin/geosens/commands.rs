@@ -386,28 +386,7 @@ fn optimisation_text(rows: &[geosens::optimize::compare::Row]) -> String {
         "run [s]",
     ];
     let cells: Vec<Vec<String>> = rows.iter().map(|r| r.cells()[1..].to_vec()).collect();
-    let width = |c: usize| {
-        cells
-            .iter()
-            .map(|r| r[c].chars().count())
-            .chain([COLUMNS[c].chars().count()])
-            .max()
-            .unwrap_or(0)
-    };
-    let widths: Vec<usize> = (0..COLUMNS.len()).map(width).collect();
-    let line = |r: &[&str]| {
-        let padded: Vec<String> = r
-            .iter()
-            .zip(&widths)
-            .map(|(c, &w)| format!("{c:<w$}"))
-            .collect();
-        padded.join("  ").trim_end().to_owned() + "\n"
-    };
-    let mut text = line(&COLUMNS);
-    for r in &cells {
-        text += &line(&r.iter().map(String::as_str).collect::<Vec<_>>());
-    }
-    text
+    geosens::optimize::compare::padded(&COLUMNS, &cells) + "\n"
 }
 
 /// The signed z-score of `e` against `exact` as the 3D table prints it:

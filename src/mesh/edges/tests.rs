@@ -1,19 +1,25 @@
 //! Unit tests of the edge hierarchy: culling, draws and their probabilities.
 use super::*;
 
+/// Uniform draws in [0, 1) from `seed` (a 64-bit LCG): fixed, and free of
+/// the crate's own random streams.
+pub(in crate::mesh) fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// 200 open edges (always discontinuities) scattered in a box, and the
 /// frequency with which a fine grid of `u` draws each against the
 /// probability the draw reports: the descent's probabilities must be
 /// those it samples with, whatever the importance.
 #[test]
 fn an_edge_is_drawn_with_the_probability_reported() {
-    let mut state = 7u64;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform(7);
     let mut edges = Vec::new();
     let mut facts = Vec::new();
     let mut weights = Vec::new();
@@ -57,13 +63,7 @@ fn an_edge_is_drawn_with_the_probability_reported() {
 /// no silhouette from the point, is ever drawn.
 #[test]
 fn the_probability_of_an_edge_is_that_of_its_draws() {
-    let mut state = 11u64;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform(11);
     let (mut edges, mut facts, mut weights) = (Vec::new(), Vec::new(), Vec::new());
     let m = 300;
     for _ in 0..m {
@@ -146,13 +146,7 @@ fn the_probability_of_an_edge_is_that_of_its_draws() {
 /// over its edges in the scene's numbering (the same draws, bit for bit).
 #[test]
 fn a_tree_joined_from_meshes_draws_as_it_reports() {
-    let mut state = 3u64;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform(3);
     let (mut edges, mut facts, mut weights) = (Vec::new(), Vec::new(), Vec::new());
     for k in 0..200 {
         // Each mesh in its own part of the box, as meshes that do not cross.
